@@ -1,0 +1,56 @@
+"""`python -m rover_web.demo`: the simulator in its own process plus the GUI, stopped by one Ctrl-C.
+
+The simulator is a separate process on purpose: the GUI talks to it over DDS exactly as it would
+talk to a real robot.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import subprocess
+import sys
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m rover_web.demo", description=__doc__)
+    parser.add_argument("--host", default=None, help="address to serve on (default ROVER_WEB_HOST, 127.0.0.1)")
+    parser.add_argument("--port", type=int, default=None, help="port (default ROVER_WEB_PORT, 5000)")
+    parser.add_argument("--domain-id", type=int, default=None,
+                        help="ROS domain for both (default: ROS_DOMAIN_ID, else a private 42)")
+    args, sim_args = parser.parse_known_args(argv)
+
+    # Keep the demo's DDS traffic on this machine unless the operator chose otherwise.
+    os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+    if args.domain_id is not None:
+        os.environ["ROS_DOMAIN_ID"] = str(args.domain_id)
+    os.environ.setdefault("ROS_DOMAIN_ID", "42")
+
+    from . import create_app
+
+    app = create_app()
+    config = app.config
+    host = args.host or config["ROVER_WEB_HOST"]
+    port = args.port or config["ROVER_WEB_PORT"]
+    sim = subprocess.Popen([sys.executable, "-m", "rover_web.sim", *sim_args])
+    print(f"rover_web: GUI on http://{'127.0.0.1' if host == '0.0.0.0' else host}:{port}/ "
+          f"(ROS domain {os.environ['ROS_DOMAIN_ID']}); Ctrl-C stops the GUI and the simulator", flush=True)
+    try:
+        app.run(host=host, port=port, threaded=True, use_reloader=False)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        app.extensions["rover_web"].shutdown()
+        if sim.poll() is None:
+            # Ctrl-C in a terminal reaches the simulator too; SIGTERM covers every other way we stop.
+            sim.send_signal(signal.SIGTERM)
+        try:
+            sim.wait(10)
+        except subprocess.TimeoutExpired:
+            sim.kill()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,200 @@
+"""EventHub: the latest value of every channel, plus a small ring of events that must not be lost.
+
+Producers (ROS callbacks, request threads) call `publish` (conflated: a newer value replaces an
+older one) or `emit` (kept in a bounded ring with ids so `Last-Event-ID` can replay it). Each event
+is serialised to its SSE frame exactly once, at publish time; a subscriber only keeps a cursor,
+so a slow browser skips stale values instead of growing a queue, and memory does not depend on
+the number or speed of clients. Pure Python: no Flask, no rclpy.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import threading
+import time
+from collections import deque
+from typing import Any, Iterable
+
+CHANNEL_RE = re.compile(r"^[a-z][a-z0-9_]{0,31}$")
+
+
+def encode(data: Any) -> str:
+    """Compact JSON; NaN and Infinity are refused because browsers cannot parse them."""
+    return json.dumps(data, separators=(",", ":"), allow_nan=False)
+
+
+def sse_frame(seq: int, channel: str, payload: str) -> bytes:
+    return f"id: {seq}\nevent: {channel}\ndata: {payload}\n\n".encode()
+
+
+class TooManyClients(RuntimeError):
+    pass
+
+
+class EventHub:
+    def __init__(self, ring_size: int = 256, max_clients: int = 256):
+        self._cond = threading.Condition()
+        self._seq = 0
+        self._latest: dict[str, tuple[int, bytes, Any]] = {}
+        self._ring: deque[tuple[int, str, bytes]] = deque(maxlen=ring_size)
+        self._channels: set[str] = set()
+        self._clients = 0
+        self._max_clients = max_clients
+        self._closed = False
+        self._throttle: dict[str, list] = {}  # channel -> [last publish time, pending value, timer]
+
+    # --- producers ---
+
+    def register(self, *channels: str) -> None:
+        """Declare channels a page may ask for; unknown names in a request are an error."""
+        for channel in channels:
+            if not CHANNEL_RE.match(channel):
+                raise ValueError(f"bad channel name {channel!r}")
+        with self._cond:
+            self._channels.update(channels)
+
+    def publish(self, channel: str, data: Any) -> int:
+        """Set the channel's latest value (conflated); returns its sequence number."""
+        payload = encode(data)
+        with self._cond:
+            self._seq += 1
+            self._latest[channel] = (self._seq, sse_frame(self._seq, channel, payload), data)
+            self._cond.notify_all()
+            return self._seq
+
+    def publish_throttled(self, channel: str, data: Any, max_hz: float) -> None:
+        """Publish at most max_hz times a second, and always the latest value in the end.
+
+        Values that arrive too soon are held, and a timer sends the newest one when the interval is
+        up, so a robot that stops is shown stopped even when its final message came in a burst.
+        """
+        interval = 1.0 / max_hz
+        now = time.monotonic()
+        with self._cond:
+            state = self._throttle.setdefault(channel, [-math.inf, None, None])
+            wait = state[0] + interval - now
+            if wait > 0:
+                state[1] = (data,)
+                if state[2] is None:
+                    state[2] = threading.Timer(wait, self._flush_throttled, args=(channel,))
+                    state[2].daemon = True
+                    state[2].start()
+                return
+            state[0] = now
+        self.publish(channel, data)
+
+    def _flush_throttled(self, channel: str) -> None:
+        with self._cond:
+            state = self._throttle[channel]
+            pending, state[1], state[2] = state[1], None, None
+            if pending is None or self._closed:
+                return
+            state[0] = time.monotonic()
+        self.publish(channel, pending[0])
+
+    def emit(self, channel: str, data: Any) -> int:
+        """An event that must reach every client in order (not conflated), kept in the ring."""
+        payload = encode(data)
+        with self._cond:
+            self._seq += 1
+            self._ring.append((self._seq, channel, sse_frame(self._seq, channel, payload)))
+            self._cond.notify_all()
+            return self._seq
+
+    def latest(self, channel: str) -> Any:
+        with self._cond:
+            entry = self._latest.get(channel)
+            return None if entry is None else entry[2]
+
+    def close(self) -> None:
+        """Wake every subscriber so its stream can end (shutdown)."""
+        with self._cond:
+            self._closed = True
+            self._cond.notify_all()
+
+    # --- consumers ---
+
+    @property
+    def channels(self) -> frozenset[str]:
+        with self._cond:
+            return frozenset(self._channels)
+
+    @property
+    def client_count(self) -> int:
+        with self._cond:
+            return self._clients
+
+    @property
+    def closed(self) -> bool:
+        return self._closed
+
+    def subscribe(self, channels: Iterable[str], last_event_id: int | None = None) -> "Subscription":
+        with self._cond:
+            if self._clients >= self._max_clients:
+                raise TooManyClients(f"{self._clients} event streams are open already")
+            self._clients += 1
+        return Subscription(self, frozenset(channels), last_event_id)
+
+    def _release(self) -> None:
+        with self._cond:
+            self._clients -= 1
+
+
+class Subscription:
+    """One client's cursor into the hub. Not thread-safe: one stream owns it."""
+
+    def __init__(self, hub: EventHub, channels: frozenset[str], last_event_id: int | None):
+        self._hub = hub
+        self.channels = channels
+        self._cursor = 0
+        # Replay only ring events the client missed; conflated values always come as a snapshot.
+        self._ring_cursor = last_event_id if last_event_id is not None else None
+        self._open = True
+
+    def snapshot(self) -> bytes:
+        """Current value of every requested channel, plus missed ring events after Last-Event-ID."""
+        hub = self._hub
+        with hub._cond:
+            frames = [(seq, frame) for ch, (seq, frame, _) in hub._latest.items() if ch in self.channels]
+            if self._ring_cursor is not None:
+                frames += [(seq, frame) for seq, ch, frame in hub._ring
+                           if seq > self._ring_cursor and ch in self.channels]
+            self._cursor = hub._seq
+        frames.sort()
+        return b"".join(frame for _, frame in frames)
+
+    def wait(self, timeout_s: float) -> bytes | None:
+        """Frames that changed since the last call, newest value only; b"" on timeout, None once closed."""
+        hub = self._hub
+        with hub._cond:
+            if hub._seq == self._cursor and not hub._closed:
+                hub._cond.wait(timeout_s)
+            if hub._closed:
+                return None
+            if hub._seq == self._cursor:
+                return b""
+            cursor = self._cursor
+            frames = [(seq, frame) for ch, (seq, frame, _) in hub._latest.items()
+                      if seq > cursor and ch in self.channels]
+            for seq, ch, frame in reversed(hub._ring):
+                if seq <= cursor:
+                    break
+                if ch in self.channels:
+                    frames.append((seq, frame))
+            self._cursor = hub._seq
+        if len(frames) > 1:
+            frames.sort()
+        return b"".join(frame for _, frame in frames)
+
+    def close(self) -> None:
+        if self._open:
+            self._open = False
+            self._hub._release()
+
+    def __enter__(self) -> "Subscription":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

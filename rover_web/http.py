@@ -1,0 +1,110 @@
+"""JSON errors, strict request bodies and the protection every route gets from the start."""
+
+from __future__ import annotations
+
+from urllib.parse import urlsplit
+
+from flask import Flask, Request, current_app, jsonify, request
+from werkzeug.exceptions import HTTPException
+
+from .validate import InvalidInput, loads_strict
+
+JSON_PREFIXES = ("/api/", "/ws/", "/stream", "/snapshot")
+STATE_CHANGING = frozenset({"POST", "PUT", "PATCH", "DELETE"})
+
+
+class ApiError(Exception):
+    def __init__(self, status: int, code: str, message: str):
+        super().__init__(message)
+        self.status, self.code, self.message = status, code, message
+
+
+def error_response(status: int, code: str, message: str):
+    response = jsonify(error=code, message=message)
+    response.status_code = status
+    return response
+
+
+def json_body(required: bool = True) -> dict:
+    """The request's JSON object, parsed strictly; ApiError(400) for anything else."""
+    raw = request.get_data(cache=True)  # honours MAX_CONTENT_LENGTH (413)
+    if not raw.strip():
+        if required:
+            raise ApiError(400, "missing_body", "send a JSON object in the request body")
+        return {}
+    try:
+        body = loads_strict(raw)
+    except InvalidInput as exc:
+        raise ApiError(400, exc.code, str(exc)) from None
+    if not isinstance(body, dict):
+        raise ApiError(400, "bad_json", f"body must be a JSON object, got {type(body).__name__}")
+    return body
+
+
+def _wants_json(req: Request) -> bool:
+    return req.path.startswith(JSON_PREFIXES) or req.method != "GET" or req.accept_mimetypes.best == "application/json"
+
+
+def host_is_trusted(host: str, trusted: list[str]) -> bool:
+    if host.startswith("["):  # [::1]:5000
+        name = host[1:host.find("]")] if "]" in host else host
+    else:
+        name = host.rsplit(":", 1)[0] if host.count(":") == 1 else host
+    name = name.lower().rstrip(".")
+    for entry in trusted:
+        entry = entry.lower()
+        if entry.startswith(".") and (name.endswith(entry) or name == entry[1:]):
+            return True
+        if name == entry:
+            return True
+    return False
+
+
+def origin_allowed(origin: str, host: str, allowed: list[str]) -> bool:
+    """Same origin as the Host the browser used, or explicitly allowed."""
+    parts = urlsplit(origin)
+    if parts.scheme in ("http", "https") and parts.netloc.lower() == host.lower():
+        return True
+    return origin.rstrip("/") in {a.rstrip("/") for a in allowed}
+
+
+def _guard():
+    config = current_app.config
+    host = request.environ.get("HTTP_HOST", "")
+    if not host_is_trusted(host, config["ROVER_WEB_TRUSTED_HOSTS"]):
+        return error_response(400, "untrusted_host",
+                              f"Host {host[:80]!r} is not in ROVER_WEB_TRUSTED_HOSTS; add it there to reach the GUI by that name")
+    is_websocket = request.headers.get("Upgrade", "").lower() == "websocket"
+    if request.method in STATE_CHANGING or is_websocket:
+        origin = request.headers.get("Origin")
+        if origin and not origin_allowed(origin, host, config["ROVER_WEB_ALLOWED_ORIGINS"]):
+            return error_response(403, "foreign_origin",
+                                  f"requests from {origin[:80]} may not control this robot; add it to ROVER_WEB_ALLOWED_ORIGINS")
+    if request.method in ("POST", "PUT", "PATCH") and request.mimetype != "application/json":
+        return error_response(415, "unsupported_media_type",
+                              "send the body as JSON with the header Content-Type: application/json")
+    return None
+
+
+def init_app(app: Flask) -> None:
+    app.before_request(_guard)
+
+    @app.errorhandler(ApiError)
+    def _api_error(exc: ApiError):
+        return error_response(exc.status, exc.code, exc.message)
+
+    @app.errorhandler(HTTPException)
+    def _http_error(exc: HTTPException):
+        if not _wants_json(request):
+            return exc
+        code = (exc.name or "error").lower().replace(" ", "_")
+        message = exc.description or exc.name
+        if exc.code == 413:
+            message = f"request body is larger than {current_app.config['ROVER_WEB_MAX_BODY_BYTES']} bytes"
+        return error_response(exc.code or 500, code, message)
+
+    @app.errorhandler(Exception)
+    def _unexpected(exc: Exception):
+        # A bug, not bad input: log it, and still answer in the API's shape.
+        current_app.logger.exception("unhandled error on %s %s", request.method, request.path)
+        return error_response(500, "internal_error", "the server hit an unexpected error; see its log")

@@ -1,0 +1,64 @@
+"""The one place velocity commands leave the process.
+
+Every feature that moves the robot goes through CmdVelOutput, so the last line of defence (finite
+values, clamped to the configured maxima, nothing after shutdown) is enforced once.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+
+from .ros.convert import twist_message
+
+
+def clamp(value: float, limit: float) -> float:
+    """Clamp to [-limit, limit]; anything non-finite becomes 0 (stop), never a command."""
+    if not isinstance(value, (int, float)) or not math.isfinite(value):
+        return 0.0
+    return max(-limit, min(limit, float(value)))
+
+
+class CmdVelOutput:
+    def __init__(self, runtime, topic: str, *, max_linear_mps: float, max_angular_rps: float,
+                 stamped: bool = False, frame_id: str = "base_link"):
+        self._runtime = runtime
+        self._stamped = stamped
+        self._frame_id = frame_id
+        self.max_linear_mps = max_linear_mps
+        self.max_angular_rps = max_angular_rps
+        msg_type = "geometry_msgs/msg/TwistStamped" if stamped else "geometry_msgs/msg/Twist"
+        self._publisher = runtime.publisher(msg_type, topic, qos=10)
+        self._lock = threading.Lock()
+        self._halted = False
+        self.last = (0.0, 0.0)
+
+    @property
+    def halted(self) -> bool:
+        return self._halted
+
+    def send(self, linear_mps: float, angular_rps: float) -> tuple[float, float]:
+        """Publish one command (clamped); returns what was published. Only zero once halted."""
+        linear = clamp(linear_mps, self.max_linear_mps)
+        angular = clamp(angular_rps, self.max_angular_rps)
+        with self._lock:
+            if self._halted:
+                linear = angular = 0.0
+            self._publish(linear, angular)
+        return linear, angular
+
+    def zero(self) -> None:
+        with self._lock:
+            self._publish(0.0, 0.0)
+
+    def halt(self) -> None:
+        """Shutdown: a zero command goes out now, and nothing but zero after it."""
+        with self._lock:
+            self._halted = True
+            self._publish(0.0, 0.0)
+
+    def _publish(self, linear: float, angular: float) -> None:
+        stamp = self._runtime.now_msg() if self._stamped else None
+        self._publisher.publish(twist_message(linear, angular, stamped=self._stamped, stamp=stamp,
+                                              frame_id=self._frame_id))
+        self.last = (linear, angular)

@@ -1,0 +1,51 @@
+"""Spin simulator nodes until SIGINT or SIGTERM, then stop them in order."""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+from typing import Callable
+
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.signals import SignalHandlerOptions
+
+
+def run_nodes(make_nodes: Callable[[Context], list]) -> None:
+    context = Context()
+    rclpy.init(context=context, signal_handler_options=SignalHandlerOptions.NO)
+    nodes = make_nodes(context)
+    executor = MultiThreadedExecutor(context=context)
+    for node in nodes:
+        executor.add_node(node)
+    stop = threading.Event()
+
+    def request_stop(signum, frame):
+        stop.set()
+        executor.wake()
+
+    signal.signal(signal.SIGINT, request_stop)
+    signal.signal(signal.SIGTERM, request_stop)
+    names = ", ".join(n.get_name() for n in nodes)
+    print(f"simulator running: {names} (domain {context.get_domain_id()}); Ctrl-C stops it", flush=True)
+    spinner = threading.Thread(target=_spin, args=(executor,), daemon=True)
+    spinner.start()
+    while not stop.wait(0.5):
+        if not spinner.is_alive():
+            break
+    executor.shutdown(timeout_sec=2.0)
+    spinner.join(2.0)
+    for node in nodes:
+        node.destroy_node()
+    context.try_shutdown()
+    print("simulator stopped", flush=True)
+    sys.stdout.flush()
+
+
+def _spin(executor) -> None:
+    try:
+        executor.spin()
+    except ExternalShutdownException:
+        pass

@@ -1,0 +1,78 @@
+"""Strict JSON input: finite numbers only, explicit ranges, clear messages. Pure Python."""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+
+class InvalidInput(ValueError):
+    """Input the client must fix; `code` is the short machine-readable reason."""
+
+    def __init__(self, message: str, code: str = "bad_request"):
+        super().__init__(message)
+        self.code = code
+
+
+def _refuse_constant(name: str) -> Any:
+    raise InvalidInput(f"{name} is not allowed: numbers must be finite", "non_finite")
+
+
+def _finite_float(text: str) -> float:
+    value = float(text)
+    if not math.isfinite(value):  # 1e400 parses to inf
+        raise InvalidInput(f"{text} is out of range: numbers must be finite", "non_finite")
+    return value
+
+
+def loads_strict(data: bytes | str) -> Any:
+    """json.loads that refuses NaN, Infinity and overflowing numbers instead of passing them on."""
+    try:
+        return json.loads(data, parse_constant=_refuse_constant, parse_float=_finite_float)
+    except InvalidInput:
+        raise
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise InvalidInput(f"body is not valid JSON: {exc}", "bad_json") from None
+    except RecursionError:
+        raise InvalidInput("body is nested too deeply", "bad_json") from None
+
+
+def number(obj: dict, key: str, *, low: float | None = None, high: float | None = None,
+           default: Any = ..., required: bool = True) -> float:
+    """A finite number field within [low, high]; booleans and strings are refused."""
+    if key not in obj or obj[key] is None and default is not ...:
+        if default is not ...:
+            return default
+        raise InvalidInput(f"'{key}' is required", "missing_field")
+    value = obj[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InvalidInput(f"'{key}' must be a number, got {type(value).__name__}", "bad_type")
+    value = float(value)
+    if not math.isfinite(value):
+        raise InvalidInput(f"'{key}' must be finite", "non_finite")
+    if low is not None and value < low or high is not None and value > high:
+        raise InvalidInput(f"'{key}' must be between {low:g} and {high:g}, got {value:g}", "out_of_range")
+    return value
+
+
+def text(obj: dict, key: str, *, max_len: int = 200, default: Any = ..., choices=None) -> str:
+    if key not in obj or obj[key] is None and default is not ...:
+        if default is not ...:
+            return default
+        raise InvalidInput(f"'{key}' is required", "missing_field")
+    value = obj[key]
+    if not isinstance(value, str):
+        raise InvalidInput(f"'{key}' must be a string, got {type(value).__name__}", "bad_type")
+    if len(value) > max_len:
+        raise InvalidInput(f"'{key}' is longer than {max_len} characters", "too_long")
+    if choices is not None and value not in choices:
+        raise InvalidInput(f"'{key}' must be one of {', '.join(choices)}; got {value[:40]!r}", "bad_value")
+    return value
+
+
+def only_keys(obj: dict, allowed: set[str]) -> None:
+    unknown = sorted(set(obj) - allowed)
+    if unknown:
+        raise InvalidInput(f"unknown field(s): {', '.join(unknown)}; allowed: {', '.join(sorted(allowed))}",
+                           "unknown_field")

