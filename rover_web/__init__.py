@@ -84,6 +84,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     from .ros import require_rclpy
     require_rclpy()
     from .core import Rover
+    from .db import Database, database_path
     from .motion import CmdVelOutput
     from .ros.runtime import RosRuntime
 
@@ -96,6 +97,8 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
                                frame_id=settings["ROVER_WEB_CMD_VEL_FRAME_ID"])
         hub = EventHub(max_clients=settings["ROVER_WEB_SSE_MAX_CLIENTS"])
         rover = Rover(settings, hub, runtime, cmd_vel)
+        rover.db = Database(database_path(app))
+        rover.on_shutdown(rover.db.close)
         app.extensions["rover_web"] = rover
         for name in FEATURES:
             importlib.import_module(f"{__name__}.{name}").init_app(app, rover)
