@@ -71,9 +71,9 @@ class EventHub:
         up, so a robot that stops is shown stopped even when its final message came in a burst.
         """
         interval = 1.0 / max_hz
-        now = time.monotonic()
-        with self._cond:
+        with self._cond:  # an RLock: publish() below re-enters it, keeping values in order
             state = self._throttle.setdefault(channel, [-math.inf, None, None])
+            now = time.monotonic()
             wait = state[0] + interval - now
             if wait > 0:
                 state[1] = (data,)
@@ -83,7 +83,8 @@ class EventHub:
                     state[2].start()
                 return
             state[0] = now
-        self.publish(channel, data)
+            state[1] = None  # anything held is older than this value; a late timer must not resend it
+            self.publish(channel, data)
 
     def _flush_throttled(self, channel: str) -> None:
         with self._cond:
@@ -92,7 +93,7 @@ class EventHub:
             if pending is None or self._closed:
                 return
             state[0] = time.monotonic()
-        self.publish(channel, pending[0])
+            self.publish(channel, pending[0])
 
     def emit(self, channel: str, data: Any) -> int:
         """An event that must reach every client in order (not conflated), kept in the ring."""
