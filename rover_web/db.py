@@ -39,6 +39,7 @@ class Database:
         self._local = threading.local()
         self._all: set[sqlite3.Connection] = set()
         self._lock = threading.Lock()
+        self._write_lock = threading.RLock()
 
     def connection(self) -> sqlite3.Connection:
         holder = getattr(self._local, "holder", None)
@@ -71,13 +72,18 @@ class Database:
     def transaction(self) -> Iterator[sqlite3.Connection]:
         """BEGIN IMMEDIATE ... COMMIT, or ROLLBACK on any exception: never a half-written record."""
         conn = self.connection()
-        conn.execute("BEGIN IMMEDIATE")
-        try:
-            yield conn
-        except BaseException:
-            conn.execute("ROLLBACK")
-            raise
-        conn.execute("COMMIT")
+        # Writers of this process queue on a lock, not in SQLite's busy handler: that one retries
+        # with sleeps of up to 100 ms, which under 8 concurrent writers gave p99 latencies of 200 ms
+        # for 2 ms writes. The lock hands over the moment a commit ends. (Re-entrant only so that a
+        # nested call fails with SQLite's clear error instead of deadlocking.)
+        with self._write_lock:
+            conn.execute("BEGIN IMMEDIATE")
+            try:
+                yield conn
+            except BaseException:
+                conn.execute("ROLLBACK")
+                raise
+            conn.execute("COMMIT")
 
     def ensure_schema(self, ddl: str) -> None:
         with self.transaction() as conn:
