@@ -1,7 +1,9 @@
 """The mission: an ordered list of GPS waypoints kept in SQLite. Pure Python, no Flask, no rclpy.
 
-Every change is one transaction (BEGIN IMMEDIATE ... COMMIT with synchronous=FULL), so a change
-the caller acknowledges is on disk, and a crash leaves either the whole change or none of it.
+Every change runs in a transaction (BEGIN IMMEDIATE ... COMMIT with synchronous=FULL; concurrent
+changes share one, see group_commit.py, each in its own savepoint) and a method returns only
+after that commit, so a change the caller acknowledges is on disk, and a crash leaves either the
+whole change or none of it.
 The table's CHECK constraints repeat the input rules, so even a bug cannot store a waypoint the
 robot must not receive (NaN becomes NULL in SQLite and fails NOT NULL; infinities fail BETWEEN).
 Positions are always exactly 0..n-1 (UNIQUE), and a mission revision counts every change so a
@@ -15,6 +17,7 @@ import time
 from dataclasses import dataclass
 from typing import Iterable, Sequence
 
+from .group_commit import GroupCommitter
 from .validate import InvalidInput
 
 MAX_LABEL_CHARS = 80
@@ -121,6 +124,10 @@ class WaypointStore:
         self.db = db
         self.max_waypoints = max_waypoints
         db.ensure_schema(SCHEMA)
+        # Every change goes through one committer thread: concurrent writers share a transaction
+        # and its fsync, and each is answered only after that commit (rover_web.group_commit).
+        self._committer = GroupCommitter(db, name="waypoints-commit")
+        self._commit = self._committer.run
 
     # --- reads ---
 
@@ -135,28 +142,22 @@ class WaypointStore:
             conn.execute("COMMIT")
         return Mission(revision, tuple(_row(r) for r in rows))
 
-    def get(self, waypoint_id: int) -> Waypoint:
-        row = self.db.connection().execute(
-            "SELECT id, position, lng, lat, label FROM waypoints WHERE id = ?", (waypoint_id,)).fetchone()
-        if row is None:
-            raise WaypointNotFound(waypoint_id)
-        return _row(row)
-
-    # --- changes: each is one transaction and bumps the revision ---
+    # --- changes: each bumps the revision, and is committed (fsynced) before the call returns ---
 
     def add(self, lng: float, lat: float, label: str = "") -> tuple[Waypoint, int]:
         """Append a waypoint; returns it and the new revision. MissionFull at the maximum."""
-        with self.db.transaction() as conn:
+        def change(conn):
             count = self._count(conn)
             if count >= self.max_waypoints:
                 raise MissionFull(self.max_waypoints)
             waypoint = self._insert(conn, count, lng, lat, label)
             return waypoint, self._bump(conn)
+        return self._commit(change)
 
     def update(self, waypoint_id: int, *, lng: float | None = None, lat: float | None = None,
                label: str | None = None, index: int | None = None) -> tuple[Waypoint, int]:
         """Move (lng/lat), rename, and/or reorder (index, 0-based; clamped to the list) one waypoint."""
-        with self.db.transaction() as conn:
+        def change(conn):
             row = conn.execute("SELECT id, position, lng, lat, label FROM waypoints WHERE id = ?",
                                (waypoint_id,)).fetchone()
             if row is None:
@@ -173,10 +174,11 @@ class WaypointStore:
             row = conn.execute("SELECT id, position, lng, lat, label FROM waypoints WHERE id = ?",
                                (waypoint_id,)).fetchone()
             return _row(row), self._bump(conn)
+        return self._commit(change)
 
     def delete(self, waypoint_id: int) -> int:
         """Remove one waypoint, closing the gap; returns the new revision."""
-        with self.db.transaction() as conn:
+        def change(conn):
             row = conn.execute("SELECT position FROM waypoints WHERE id = ?", (waypoint_id,)).fetchone()
             if row is None:
                 raise WaypointNotFound(waypoint_id)
@@ -185,27 +187,31 @@ class WaypointStore:
             conn.execute("UPDATE waypoints SET position = position + ? WHERE position > ?", (_SHIFT, position))
             conn.execute("UPDATE waypoints SET position = position - ? - 1 WHERE position >= ?", (_SHIFT, _SHIFT))
             return self._bump(conn)
+        return self._commit(change)
 
     def clear(self) -> tuple[int, int]:
         """Remove every waypoint; returns (how many, new revision)."""
-        with self.db.transaction() as conn:
+        def change(conn):
             deleted = conn.execute("DELETE FROM waypoints").rowcount
             return deleted, self._bump(conn)
+        return self._commit(change)
 
     def replace(self, points: Sequence[tuple[float, float, str]], *, expected_revision: int | None = None) -> Mission:
         """Make `points` (lng, lat, label) the whole mission, in order, atomically (GeoJSON import)."""
         if len(points) > self.max_waypoints:
             raise MissionFull(self.max_waypoints)
-        with self.db.transaction() as conn:
+
+        def change(conn):
             if expected_revision is not None:
                 self._check_revision(conn, expected_revision)
             conn.execute("DELETE FROM waypoints")
             waypoints = tuple(self._insert(conn, i, lng, lat, label) for i, (lng, lat, label) in enumerate(points))
             return Mission(self._bump(conn), waypoints)
+        return self._commit(change)
 
-    def check_revision(self, expected: int) -> None:
-        conn = self.db.connection()
-        self._check_revision(conn, expected)
+    def close(self) -> None:
+        """Let queued changes commit, then stop the committer thread."""
+        self._committer.stop()
 
     # --- helpers (inside a transaction) ---
 

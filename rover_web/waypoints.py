@@ -310,6 +310,7 @@ def init_app(app, rover: Rover) -> None:
     rover.hub.register("waypoints", "fix")
     waypoints.broadcaster.start()
     rover.on_shutdown(waypoints.broadcaster.stop)
+    rover.on_shutdown(waypoints.store.close)  # runs first: queued changes commit before the db closes
     app.context_processor(lambda: {"waypoints_panel": waypoints.panel_context})
     rover.add_panel(20, "panels/waypoints.html", "GPS waypoints", channels=("waypoints", "fix"))
     rover.add_nav("Waypoints", "/waypoints")

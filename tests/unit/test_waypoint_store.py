@@ -20,7 +20,9 @@ def db(tmp_path):
 
 @pytest.fixture
 def store(db):
-    return WaypointStore(db, max_waypoints=5)
+    store = WaypointStore(db, max_waypoints=5)
+    yield store
+    store.close()
 
 
 def positions_are_contiguous(db) -> bool:
@@ -124,14 +126,18 @@ def test_the_schema_refuses_duplicate_or_negative_positions_and_long_labels(db, 
 def test_the_mission_survives_reopening_the_file(tmp_path):
     path = tmp_path / "again.sqlite3"
     first = Database(path)
-    WaypointStore(first, 10).add(-82.45, 27.37, "dock")
+    store = WaypointStore(first, 10)
+    store.add(-82.45, 27.37, "dock")
+    store.close()
     first.close()
     second = Database(path)
+    store = WaypointStore(second, 10)
     try:
-        mission = WaypointStore(second, 10).mission()  # ensure_schema again: nothing is reset
+        mission = store.mission()  # ensure_schema again: nothing is reset
         assert [(w.lng, w.lat, w.label) for w in mission.waypoints] == [(-82.45, 27.37, "dock")]
         assert mission.revision == 1
     finally:
+        store.close()
         second.close()
 
 
