@@ -24,6 +24,7 @@ from flask import Blueprint, current_app, jsonify, render_template, request
 
 from .core import Rover
 from .gps import GpsTrack
+from .group_commit import CommitterStopped
 from .http import ApiError, error_response, json_body
 from .mission_geojson import MEDIA_TYPE, mission_to_geojson, waypoints_from_geojson
 from .ros.waypoints_msgs import FLOAT64_MULTI_ARRAY, NAV_SAT_FIX, fix_reading, mission_message, waypoint_message
@@ -300,6 +301,11 @@ def _stale(exc: StaleRevision):
 def _storage(exc: sqlite3.OperationalError):
     current_app.logger.error("waypoint storage: %s", exc)
     return error_response(503, "storage_unavailable", f"the waypoint database could not be written: {exc}")
+
+
+@bp.errorhandler(CommitterStopped)
+def _stopping(exc: CommitterStopped):
+    return error_response(503, "shutting_down", "the server is shutting down; nothing was stored")
 
 
 def init_app(app, rover: Rover) -> None:

@@ -202,3 +202,10 @@ def test_schema_has_the_documented_checks(wp_app, api):
     finally:
         conn.close()
     assert "lat BETWEEN -90.0 AND 90.0" in ddl and "lng BETWEEN -180.0 AND 180.0" in ddl and "UNIQUE" in ddl
+
+
+def test_a_write_during_shutdown_is_503_not_a_crash(wp_app, api):
+    wp_app.extensions["rover_web.waypoints"].store.close()  # what shutdown does first
+    r = api.post("/waypoints", json={"lng": 1.0, "lat": 2.0})
+    assert r.status_code == 503 and r.get_json()["error"] == "shutting_down"
+    assert stored_rows(db_path(wp_app)) == []
