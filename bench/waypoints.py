@@ -1,6 +1,6 @@
 """POST /waypoints (the seeds' call) at 1 and 8 concurrent clients: throughput, HTTP latency, latency
 to the /waypoints topic, server CPU and RSS; then checks every acknowledged waypoint is on the
-topic and in the database.
+topic and in the database, and that the topic carried them in the mission's order.
 
     .venv/bin/python bench/waypoints.py [--requests 3000] [--clients 1 8] [--server gunicorn|flask]
 
@@ -19,13 +19,12 @@ import json
 import os
 import sqlite3
 import statistics
+import subprocess
 import sys
 import tempfile
 import threading
 import time
 from pathlib import Path
-
-import subprocess
 
 import psutil
 import requests
@@ -129,9 +128,12 @@ def run_level(server: Server, peer, db_path: Path, clients: int, total: int, tag
     topic_latency = [heard[(lng, lat)] - t0 for lng, lat, t0, _, _ in acked if (lng, lat) in heard]
     conn = sqlite3.connect(db_path)
     try:
-        stored = set(conn.execute("SELECT lng, lat FROM waypoints WHERE lat = ?", (tag,)).fetchall())
+        stored_in_order = conn.execute("SELECT lng, lat FROM waypoints WHERE lat = ? ORDER BY position",
+                                       (tag,)).fetchall()
     finally:
         conn.close()
+    stored = set(stored_in_order)
+    heard_in_order = [tuple(m["msg"]["data"]) for m in peer.received("/waypoints")]
     return {
         "clients": clients, "sent": len(results), "acked": len(acked), "wall_s": wall,
         "throughput": len(acked) / wall,
@@ -139,6 +141,7 @@ def run_level(server: Server, peer, db_path: Path, clients: int, total: int, tag
         "topic_ms": [x * 1000 for x in topic_latency],
         "missing_topic": sum(1 for lng, lat, *_ in acked if (lng, lat) not in heard),
         "missing_db": sum(1 for lng, lat, *_ in acked if (lng, lat) not in stored),
+        "same_order": heard_in_order == stored_in_order,
         "cpu_pct": 100 * cpu / wall, "rss_mb": server_rss_mb(server),
     }
 
@@ -176,7 +179,8 @@ def main() -> None:
             print(f"clients {clients}: {r['throughput']:7.1f} req/s ({r['acked']}/{r['sent']} acknowledged in "
                   f"{r['wall_s']:.1f} s)  HTTP {fmt(r['http_ms'])}  to topic {fmt(r['topic_ms'])}  "
                   f"server CPU {r['cpu_pct']:5.1f}% of a core  RSS {r['rss_mb']:.0f} MB  "
-                  f"missing: topic {r['missing_topic']}, database {r['missing_db']}", flush=True)
+                  f"missing: topic {r['missing_topic']}, database {r['missing_db']}; topic order "
+                  f"{'= mission order' if r['same_order'] else 'DIFFERS from mission order'}", flush=True)
     finally:
         peer.close()
         server.stop()

@@ -25,10 +25,11 @@ class CommitterStopped(RuntimeError):
 
 
 class _Change:
-    __slots__ = ("fn", "done", "result", "error")
+    __slots__ = ("fn", "after_commit", "done", "result", "error")
 
-    def __init__(self, fn: Callable[[Any], Any]):
+    def __init__(self, fn: Callable[[Any], Any], after_commit: Callable[[Any], None] | None):
         self.fn = fn
+        self.after_commit = after_commit
         self.done = threading.Event()
         self.result: Any = None
         self.error: BaseException | None = None
@@ -44,9 +45,13 @@ class GroupCommitter:
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
         self._thread.start()
 
-    def run(self, fn: Callable[[Any], Any]) -> Any:
-        """Apply fn(conn) in a committed transaction; its result, or the exception it raised."""
-        change = _Change(fn)
+    def run(self, fn: Callable[[Any], Any], after_commit: Callable[[Any], None] | None = None) -> Any:
+        """Apply fn(conn) in a committed transaction; its result, or the exception it raised.
+
+        after_commit(result), if given, runs on the committer thread once the change is on disk,
+        in commit order across all writers (so announcements come in the order of the data).
+        """
+        change = _Change(fn, after_commit)
         with self._lock:
             if self._stopped:
                 raise CommitterStopped("the database is shutting down")
@@ -95,6 +100,12 @@ class GroupCommitter:
                 change.result = None
         self.batches += 1
         for change in batch:
+            if change.error is None and change.after_commit is not None:
+                try:
+                    change.after_commit(change.result)
+                except Exception as exc:  # stored, but not announced: the writer must hear of it
+                    log.exception("after-commit action failed")
+                    change.error = exc
             change.done.set()
 
     def _fail_pending(self) -> None:

@@ -22,7 +22,7 @@ from flask import Blueprint, Flask, Response, current_app
 from flask.cli import AppGroup
 
 from . import ROOT
-from .tile_store import (MAX_ZOOM, MEDIA_TYPES, FolderTiles, MBTiles, TileStoreError, image_format,
+from .tile_store import (MAX_ZOOM, MEDIA_TYPES, MBTiles, TileStoreError, image_format,
                          open_tile_store, tile_count, tile_ranges, valid_tile)
 
 MAP_FILES = ROOT / "map_files"

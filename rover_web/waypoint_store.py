@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import Iterable, Sequence
+from typing import Callable, Iterable, Sequence
 
 from .group_commit import GroupCommitter
 from .validate import InvalidInput
@@ -144,15 +144,20 @@ class WaypointStore:
 
     # --- changes: each bumps the revision, and is committed (fsynced) before the call returns ---
 
-    def add(self, lng: float, lat: float, label: str = "") -> tuple[Waypoint, int]:
-        """Append a waypoint; returns it and the new revision. MissionFull at the maximum."""
+    def add(self, lng: float, lat: float, label: str = "",
+            announce: Callable[[Waypoint], None] | None = None) -> tuple[Waypoint, int]:
+        """Append a waypoint; returns it and the new revision. MissionFull at the maximum.
+
+        announce(waypoint) runs once it is committed, in mission order even for concurrent adds.
+        """
         def change(conn):
             count = self._count(conn)
             if count >= self.max_waypoints:
                 raise MissionFull(self.max_waypoints)
             waypoint = self._insert(conn, count, lng, lat, label)
             return waypoint, self._bump(conn)
-        return self._commit(change)
+        after = (lambda result: announce(result[0])) if announce else None
+        return self._commit(change, after)
 
     def update(self, waypoint_id: int, *, lng: float | None = None, lat: float | None = None,
                label: str | None = None, index: int | None = None) -> tuple[Waypoint, int]:

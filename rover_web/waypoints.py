@@ -116,10 +116,14 @@ class WaypointsFeature:
     # --- changes ---
 
     def add(self, lng: float, lat: float, label: str = "") -> Waypoint:
-        waypoint, _revision = self.store.add(lng, lat, label)  # committed before anything is announced
-        self.waypoint_pub.publish(waypoint_message(waypoint.lng, waypoint.lat))
+        # Published once committed, by the committer thread: /waypoints carries the waypoints in
+        # the mission's order even when several browsers or scripts add at the same moment.
+        waypoint, _revision = self.store.add(lng, lat, label, announce=self._announce)
         self.broadcaster.changed()
         return waypoint
+
+    def _announce(self, waypoint: Waypoint) -> None:
+        self.waypoint_pub.publish(waypoint_message(waypoint.lng, waypoint.lat))
 
     def changed(self) -> None:
         self.broadcaster.changed()

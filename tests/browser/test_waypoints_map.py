@@ -4,6 +4,7 @@ the offline basemap; nothing ever leaves 127.0.0.1 and the console stays free of
 import io
 import subprocess
 import sys
+from pathlib import Path
 import time
 
 import pytest
@@ -13,7 +14,7 @@ from tests.waypoint_helpers import FLOAT64_MULTI_ARRAY, TileServer, stored_rows,
 
 pytestmark = pytest.mark.browser
 
-ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def open_map(page, url):

@@ -6,6 +6,7 @@ import re
 import sqlite3
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -13,7 +14,7 @@ from rover_web.tile_store import tile_count
 from tests.rospeer import subprocess_env
 from tests.waypoint_helpers import TileServer
 
-ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[2]
 BBOX = "-82.462,27.366,-82.438,27.382"  # Nathan Benderson Park
 BBOX_TUPLE = (-82.462, 27.366, -82.438, 27.382)
 

@@ -3,6 +3,7 @@
 import json
 import math
 import subprocess
+import threading
 import time
 
 import requests
@@ -34,6 +35,32 @@ def test_the_seed_curl_call_publishes_lng_first(server_process, ros_peer):
     assert len(peer.received("/waypoints")) == 1
     listed = requests.get(server.url + "/api/waypoints", timeout=5).json()
     assert [(w["lng"], w["lat"]) for w in listed["waypoints"]] == [(1.0, 2.0)]
+
+
+def test_concurrent_adds_reach_the_topic_in_mission_order(live_server, ros_peer):
+    url = live_server.url
+    peer = ros_peer("order_listener")
+    peer.subscribe("/waypoints", FLOAT64_MULTI_ARRAY, qos=1000)
+    peer.wait_match("/waypoints")
+    warm_up_topic(url, peer)
+
+    def client(c):
+        session = requests.Session()
+        for i in range(25):
+            route = "/waypoints" if i % 2 else "/api/waypoints"
+            assert session.post(url + route, json={"lng": c + i / 100, "lat": -c}, timeout=10).ok
+
+    threads = [threading.Thread(target=client, args=(c,)) for c in range(1, 9)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(30)
+    stored = [[w["lng"], w["lat"]] for w in requests.get(url + "/api/waypoints", timeout=5).json()["waypoints"]]
+    assert len(stored) == 200
+    deadline = time.monotonic() + 10
+    while len(peer.received("/waypoints")) < 200 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert [m["msg"]["data"] for m in peer.received("/waypoints")] == stored
 
 
 def test_send_mission_is_one_n_by_2_array_in_mission_order(live_server, ros_peer):

@@ -108,3 +108,35 @@ def test_after_stop_nothing_is_accepted(db):
     with pytest.raises(CommitterStopped):
         committer.run(lambda c: c.execute("INSERT INTO t VALUES (8)"))
     assert rows(db) == [7]
+
+
+def test_after_commit_actions_run_once_committed_in_commit_order(db):
+    committer = GroupCommitter(db)
+    announced, seen_committed = [], []
+
+    def announce(value):
+        seen_committed.append(value in rows(db))
+        announced.append(value)
+
+    def writer(i):
+        committer.run(lambda conn: conn.execute("INSERT INTO t VALUES (?)", (i,)) and i, after_commit=announce)
+
+    threads = [threading.Thread(target=writer, args=(i,)) for i in range(30)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(5)
+    conn = sqlite3.connect(db.path)
+    try:
+        commit_order = [r[0] for r in conn.execute("SELECT x FROM t ORDER BY rowid")]
+    finally:
+        conn.close()
+    assert announced == commit_order and all(seen_committed)
+
+    def broken(_):
+        raise RuntimeError("publisher gone")
+
+    with pytest.raises(RuntimeError, match="publisher gone"):
+        committer.run(lambda conn: conn.execute("INSERT INTO t VALUES (99)"), after_commit=broken)
+    assert 99 in rows(db)  # stored all the same: the writer learns it was not announced
+    committer.stop()
