@@ -60,3 +60,16 @@ def wait_display(base_url: str, panel: str, display_id: str, value, timeout: flo
         if time.monotonic() > deadline:
             raise AssertionError(f"{panel}/{display_id} never showed {value!r}; last {shown}")
         time.sleep(0.05)
+
+
+def wait_subscribers(base_url: str, panel: str, minimum: dict[str, int], timeout: float = 15.0) -> None:
+    """Poll until each control's topic has at least `minimum[control]` matched subscribers."""
+    deadline = time.monotonic() + timeout
+    while True:
+        controls = {c["id"]: c for c in requests.get(f"{base_url}/api/panels/{panel}", timeout=10).json()["controls"]}
+        if all(controls[cid]["subscribers"] >= n for cid, n in minimum.items()):
+            return
+        if time.monotonic() > deadline:
+            raise AssertionError(f"subscribers never matched {minimum}: "
+                                 f"{ {cid: controls[cid]['subscribers'] for cid in minimum} }")
+        time.sleep(0.05)

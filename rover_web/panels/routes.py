@@ -58,12 +58,12 @@ def panel_summaries():
 @bp.get("/api/panels")
 def list_panels():
     svc = service()
-    return jsonify(panels=[state.detail() for state in svc.states.values()])
+    return jsonify(panels=[svc.detail(pid) for pid in svc.specs])
 
 
 @bp.get("/api/panels/<panel_id>")
 def get_panel(panel_id: str):
-    return jsonify(service().panel(panel_id).detail())
+    return jsonify(service().detail(panel_id))
 
 
 @bp.get("/api/panels/<panel_id>/log")

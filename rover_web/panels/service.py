@@ -62,6 +62,13 @@ class PanelService:
             self.publish_view()
         return on_message
 
+    def detail(self, panel_id: str) -> dict:
+        """The API's view of one panel, with how many subscribers each control's topic has."""
+        detail = self.panel(panel_id).detail()
+        for control in detail["controls"]:
+            control["subscribers"] = self._publishers[control["topic"]].get_subscription_count()
+        return detail
+
     def views(self) -> dict[str, dict]:
         now = time.monotonic()
         return {pid: state.view(now) for pid, state in self.states.items()}
