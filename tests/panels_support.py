@@ -8,6 +8,7 @@ import sys
 import threading
 import time
 
+import pytest
 import requests
 
 from tests.rospeer import ROOT, subprocess_env
@@ -39,6 +40,21 @@ class DroneProcess:
             except subprocess.TimeoutExpired:
                 self.proc.kill()
         return self.proc.wait(5)
+
+
+@pytest.fixture
+def drone_sim():
+    """Start the simulated drone with the given arguments; stopped at the end of the test."""
+    started = []
+
+    def start(*args: str) -> DroneProcess:
+        sim = DroneProcess(*args)
+        started.append(sim)
+        return sim
+
+    yield start
+    for sim in started:
+        sim.stop()
 
 
 def post(base_url: str, path: str, body: dict | None = None) -> requests.Response:

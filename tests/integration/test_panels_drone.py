@@ -3,34 +3,19 @@
 import re
 import time
 
-import pytest
 import requests
 
 from tests.integration.test_panels_api import STRING, feed_status, log_entries
-from tests.panels_support import DroneProcess, post, wait_display, wait_subscribers
+from tests.panels_support import drone_sim, post, wait_display, wait_subscribers  # noqa: F401 (fixture)
 
 INT8 = "std_msgs/msg/Int8"
-
-
-@pytest.fixture
-def drone_sim():
-    started = []
-
-    def start(*args: str) -> DroneProcess:
-        sim = DroneProcess(*args)
-        started.append(sim)
-        return sim
-
-    yield start
-    for sim in started:
-        sim.stop()
 
 
 def status_of(event) -> str:
     return event["json"]["panels"]["drone"]["displays"]["status"]["value"]
 
 
-def test_take_off_return_and_refusals_with_the_simulated_drone(live_server, drone_sim, ros_peer, sse_client):
+def test_take_off_return_and_refusals_with_the_simulated_drone(live_server, drone_sim, ros_peer, sse_client):  # noqa: F811
     sim = drone_sim("--drone-transition-s", "1.5", "--drone-rate-hz", "10")
     url = live_server.url
     listener = ros_peer("listener")
