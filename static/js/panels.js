@@ -3,7 +3,7 @@
 // allowed; the page only mirrors it so an operator sees why a button is disabled.
 import { on } from './live.js';
 
-const LIGHT_TEXT = { green: 'no mission', red: 'mission running', unknown: 'unknown' };
+const LIGHT_TEXT = { green: 'not running', red: 'running', unknown: 'unknown' };
 
 const panelRoot = (id) => document.querySelector(`[data-panel="${CSS.escape(id)}"]`);
 const summaryRoot = (id) => document.querySelector(`[data-panel-summary="${CSS.escape(id)}"]`);
