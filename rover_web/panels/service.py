@@ -75,8 +75,8 @@ class PanelService:
 
     def publish_view(self) -> None:
         """Send the `panel` channel if anything an operator sees changed (values, staleness, lock, rules)."""
-        views = self.views()
-        with self._view_lock:
+        with self._view_lock:  # computed under the lock, so an older view can never be sent after a newer one
+            views = self.views()
             if views == self._last_view:
                 return
             self._last_view = views

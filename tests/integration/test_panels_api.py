@@ -1,7 +1,6 @@
 """The panels API with real ROS peers: 404/400/409, nothing published on refusal, every scalar type,
 the unlock timeout, staleness on SSE, the operator log in SQLite, and a bad panel file at start."""
 
-import json
 import re
 import time
 
@@ -9,7 +8,7 @@ import pytest
 import requests
 
 from rover_web.config import ConfigError
-from tests.panels_support import JSON, display, post, wait_display
+from tests.panels_support import JSON, display, post
 
 STRING, INT8 = "std_msgs/msg/String", "std_msgs/msg/Int8"
 
