@@ -14,6 +14,7 @@ import requests
 from tests.rospeer import ROOT, subprocess_env
 
 JSON = {"Content-Type": "application/json"}
+STRING = "std_msgs/msg/String"
 
 
 class DroneProcess:
@@ -89,3 +90,19 @@ def wait_subscribers(base_url: str, panel: str, minimum: dict[str, int], timeout
             raise AssertionError(f"subscribers never matched {minimum}: "
                                  f"{ {cid: controls[cid]['subscribers'] for cid in minimum} }")
         time.sleep(0.05)
+
+
+def feed_status(peer, base_url: str, value: str, panel: str = "drone", timeout: float = 15.0) -> None:
+    """Publish /status until the app shows it (discovery matches the two ends a moment apart)."""
+    deadline = time.monotonic() + timeout
+    while True:
+        peer.publish("/status", {"data": value})
+        shown = display(base_url, panel, "status")
+        if shown["fresh"] and shown["value"] == value:
+            return
+        assert time.monotonic() < deadline, f"the app never showed status {value!r}: {shown}"
+        time.sleep(0.05)
+
+
+def log_entries(base_url: str, panel: str = "drone", limit: int = 50) -> list[dict]:
+    return requests.get(f"{base_url}/api/panels/{panel}/log", params={"limit": limit}, timeout=10).json()["entries"]

@@ -8,25 +8,9 @@ import pytest
 import requests
 
 from rover_web.config import ConfigError
-from tests.panels_support import JSON, display, post
+from tests.panels_support import JSON, STRING, display, feed_status, log_entries, post
 
-STRING, INT8 = "std_msgs/msg/String", "std_msgs/msg/Int8"
-
-
-def feed_status(peer, base_url: str, value: str, panel: str = "drone", timeout: float = 15.0) -> None:
-    """Publish /status until the app shows it (discovery matches the two ends a moment apart)."""
-    deadline = time.monotonic() + timeout
-    while True:
-        peer.publish("/status", {"data": value})
-        shown = display(base_url, panel, "status")
-        if shown["fresh"] and shown["value"] == value:
-            return
-        assert time.monotonic() < deadline, f"the app never showed status {value!r}: {shown}"
-        time.sleep(0.05)
-
-
-def log_entries(base_url: str, panel: str = "drone", limit: int = 50) -> list[dict]:
-    return requests.get(f"{base_url}/api/panels/{panel}/log", params={"limit": limit}, timeout=10).json()["entries"]
+INT8 = "std_msgs/msg/Int8"
 
 
 def test_unknown_panel_or_control_is_404_and_not_logged(client):

@@ -5,8 +5,7 @@ import time
 
 import requests
 
-from tests.integration.test_panels_api import STRING, feed_status, log_entries
-from tests.panels_support import drone_sim, post, wait_display, wait_subscribers  # noqa: F401 (fixture)
+from tests.panels_support import STRING, drone_sim, feed_status, log_entries, post, wait_display, wait_subscribers  # noqa: F401
 
 INT8 = "std_msgs/msg/Int8"
 
