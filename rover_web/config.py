@@ -72,6 +72,12 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("CMD_VEL_FRAME_ID", "base_link", "str", "frame_id of TwistStamped commands"),
     Setting("MAX_LINEAR_MPS", 5.0, "float", "linear speed at full joystick deflection (m/s)", 0.0, 100),
     Setting("MAX_ANGULAR_RPS", 2.0, "float", "turn rate at full joystick deflection (rad/s)", 0.0, 100),
+    # --- panels ---
+    Setting("PANELS_FILE", None, "optional_str",
+            "TOML file defining the mission control panels; unset means the drone panel in rover_web/panels/drone.toml"),
+    Setting("PANELS_LOG_SHOWN", 20, "int", "operator-log entries a panel page shows (newest first)", 1, 500),
+    Setting("PANELS_LOG_KEEP", 10000, "int", "operator-log entries kept per panel in the database (oldest deleted)",
+            100, 10_000_000),
 )
 
 _BY_NAME = {PREFIX + s.name: s for s in SETTINGS}
