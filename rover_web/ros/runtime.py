@@ -83,7 +83,8 @@ class RosRuntime:
             self.executor.shutdown(timeout_sec=timeout_s)
         except Exception:
             log.exception("executor shutdown failed")
-        self._thread.join(timeout_s)
+        if self._thread.ident is not None:  # a feature that failed in init_app stops us before start()
+            self._thread.join(timeout_s)
         try:
             self.node.destroy_node()
         finally:
