@@ -388,6 +388,8 @@ async function sendGoal(x, y, yaw, what) {
 function setMode(mode) {
   S.mode = mode;
   S.preview = null;
+  $('livemap-goal-mode').setAttribute('aria-pressed', mode === 'goal' ? 'true' : 'false');
+  root.dataset.mode = mode;
   canvas.style.cursor = mode === 'goal' ? 'crosshair' : 'grab';
   if (mode === 'goal') message('Click the goal, or press and drag towards the heading you want. Esc cancels.');
   requestDraw();
@@ -437,7 +439,7 @@ function startPinch() {
 
 canvas.addEventListener('pointerdown', (event) => {
   canvas.focus({ preventScroll: true });
-  canvas.setPointerCapture(event.pointerId);
+  try { canvas.setPointerCapture(event.pointerId); } catch { /* a pointer already gone */ }
   pointers.set(event.pointerId, local(event));
   if (pointers.size === 2) { startPinch(); return; }
   if (pointers.size > 2) return;
