@@ -74,7 +74,7 @@ SETTINGS: tuple[Setting, ...] = (
     # --- livemap ---
     Setting("MAPS_FILE", "map_files/all_maps.json", "optional_str",
             "floorplans: an all_maps.json catalog or one map_server yaml (relative paths from the repository "
-            "root); empty for none"),
+            "root); set it empty in the environment for none"),
     Setting("LIVEMAP_DEFAULT_MAP", None, "optional_str", "map /livemap and the dashboard show first; unset: the first one"),
     Setting("LIVEMAP_BOT_DIAMETER_CM", 35.4, "float", "robot diameter drawn on the map (cm)", 1, 10000),
     Setting("AMCL_POSE_TOPIC", "/amcl_pose", "topic",

@@ -115,6 +115,8 @@ class LiveMap:
 
     def _scaled(self, pose: Pose2D) -> dict:
         px, py = self.to_pixels(pose.x, pose.y)
+        if not (math.isfinite(px) and math.isfinite(py)):  # a finite pose can still overflow in pixels
+            px = py = None
         return {"x": px, "y": py, "yaw": self.geometry.yaw_to_image(pose.yaw),
                 "inside": self.geometry.contains(pose.x, pose.y)}
 
@@ -208,8 +210,9 @@ def pose_payload(pose: Pose2D, maps: Iterable[MapDefinition], *, stale: bool = F
     for definition in maps:
         g = definition.geometry
         px, py = g.world_to_pixel(pose.x, pose.y)
-        pixels[definition.name] = {"x": _r(px, 2), "y": _r(py, 2), "yaw": _r(g.yaw_to_image(pose.yaw), 4),
-                                   "inside": g.contains(pose.x, pose.y)}
+        finite = math.isfinite(px) and math.isfinite(py)  # 1e308 m is finite, its pixel column is not
+        pixels[definition.name] = {"x": _r(px, 2) if finite else None, "y": _r(py, 2) if finite else None,
+                                   "yaw": _r(g.yaw_to_image(pose.yaw), 4), "inside": g.contains(pose.x, pose.y)}
     return {"x": _r(pose.x, 4), "y": _r(pose.y, 4), "yaw": _r(wrap_angle(pose.yaw), 4), "frame_id": pose.frame_id,
             "stamp": _r(pose.stamp_s, 6), "stale": stale, "age_s": None if age_s is None else _r(age_s, 2),
             "pixels": pixels}

@@ -166,3 +166,22 @@ def test_bad_goals_are_400_and_publish_nothing(client, ros_peer):
     time.sleep(0.3)
     assert [m["msg"]["pose"]["position"]["x"] for m in peer.received("/goal_pose")] == [5.0]
     assert before["x"] == 0.0  # the warm-up goal stood until the good one replaced it
+
+
+def test_maps_settings_default_map_single_yaml_and_none(app_factory):
+    from rover_web import ROOT
+    from rover_web.config import ConfigError
+
+    with pytest.raises(ConfigError, match="ROVER_WEB_LIVEMAP_DEFAULT_MAP: no map named 'Attic'"):
+        app_factory(ROVER_WEB_LIVEMAP_DEFAULT_MAP="Attic")
+    lab_first = app_factory(ROVER_WEB_LIVEMAP_DEFAULT_MAP=LAB).test_client()
+    assert lab_first.get("/api/maps").json["default"] == LAB
+    assert lab_first.get("/livemap").location.endswith(f"/livemap/{quote(LAB)}")
+    one = app_factory(ROVER_WEB_MAPS_FILE=str(ROOT / "map_files" / "lab" / "lab.yaml")).test_client()
+    assert [m["name"] for m in one.get("/api/maps").json["maps"]] == ["lab"]
+    assert one.get("/api/maps/lab").json["map_parameters"]["files"]["yaml_file"] == "lab.yaml"
+    none = app_factory(ROVER_WEB_MAPS_FILE=None).test_client()   # ROVER_WEB_MAPS_FILE= in the environment
+    assert none.get("/api/maps").json == {"maps": [], "default": None}
+    page = none.get("/livemap")
+    assert page.status_code == 200 and b"No map to show yet" in page.data
+    assert none.get("/").status_code == 200

@@ -123,6 +123,16 @@ def test_payloads_carry_pixels_for_every_map():
     assert plan["points"][0] == [0.0, 0.0] and plan["points"][-1] == [19.99, 0.0]
 
 
+def test_a_far_away_pose_has_no_pixel_but_stays_valid_json():
+    import json
+    payload = pose_payload(Pose2D(1e308, 0.0, 0.0), [HALL])
+    assert payload["pixels"]["Hall"] == {"x": None, "y": None, "yaw": 0.0, "inside": False}
+    json.dumps(payload, allow_nan=False)
+    live = LiveMap("Hall", catalog=CATALOG)
+    live.update_current_pose(Pose2D(-1e308, 0.0, 0.0))
+    json.dumps(live.map_state, allow_nan=False)
+
+
 def test_occupancy_grid_image_distinguishes_free_occupied_and_unknown():
     width, height = 4, 3
     cells = np.full(width * height, -1, dtype=np.int8)
