@@ -170,8 +170,11 @@ class RobotTrack:
     def set_goal(self, goal: Pose2D) -> bool:
         """Record a goal; False if it is the one already recorded (our own publication, heard back)."""
         with self._lock:
-            if goal == self._goal:
-                return False
+            old = self._goal
+            if old is not None and (goal.frame_id, goal.stamp_s) == (old.frame_id, old.stamp_s) and all(
+                    math.isclose(a, b, abs_tol=1e-9) for a, b in ((goal.x, old.x), (goal.y, old.y),
+                                                                  (goal.yaw, old.yaw))):
+                return False  # yaw -> quaternion -> yaw may differ in the last bit
             self._goal = goal
             return True
 

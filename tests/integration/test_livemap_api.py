@@ -185,3 +185,9 @@ def test_maps_settings_default_map_single_yaml_and_none(app_factory):
     page = none.get("/livemap")
     assert page.status_code == 200 and b"No map to show yet" in page.data
     assert none.get("/").status_code == 200
+
+
+def test_the_dashboard_renders_the_robot_dot_with_the_page(app):
+    app.extensions["livemap"].on_pose((18.0, 10.5, 0.0, "map", 1.0))   # as the /amcl_pose callback would
+    html = app.test_client().get("/").data.decode()
+    assert 'style="left: 50.0%; top: 50.0%"' in html and "18.0, 10.5 m" in html

@@ -95,7 +95,7 @@ def test_track_staleness_and_goal_echo():
     assert never.pose()[2] is False
     goal = Pose2D(1.0, 2.0, 0.5, "map", 3.0)
     assert track.set_goal(goal) is True
-    assert track.set_goal(Pose2D(1.0, 2.0, 0.5, "map", 3.0)) is False  # the same goal heard back
+    assert track.set_goal(Pose2D(1.0, 2.0, 0.5 + 1e-15, "map", 3.0)) is False  # the same goal heard back
     assert track.set_goal(Pose2D(1.0, 2.0, 0.5, "map", 4.0)) is True
 
 
