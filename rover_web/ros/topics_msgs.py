@@ -11,7 +11,12 @@ from .convert import message_to_dict
 from .typesupport import message_class
 
 
+UNKNOWN_NODE = "(node not known yet)"
+
+
 def _node(endpoint) -> str:
+    if endpoint.node_name == "_NODE_NAME_UNKNOWN_":  # endpoint discovered before its node's name
+        return UNKNOWN_NODE
     namespace = endpoint.node_namespace.rstrip("/")
     return f"{namespace}/{endpoint.node_name}"
 
