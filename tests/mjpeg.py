@@ -1,7 +1,8 @@
 """A small MJPEG (multipart/x-mixed-replace) client for tests and benchmarks: raw socket, one thread.
 
 Each part is kept as (arrival time, headers, JPEG bytes), or only counted with keep_frames=False
-(benchmarks with many viewers).
+(benchmarks with many viewers). `latencies` collects wall-clock arrival minus the part's
+X-Timestamp (the image's header stamp), in seconds.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ class MjpegClient:
         self.bytes = 0
         self.first_at: float | None = None
         self.last_at: float | None = None
+        self.latencies: list[float] = []
         self.closed = threading.Event()
         self._cond = threading.Condition()
         self._thread = threading.Thread(target=self._read, daemon=True)
@@ -74,7 +76,10 @@ class MjpegClient:
                 if data is None:
                     return
                 now = time.monotonic()
+                wall = time.time()
                 with self._cond:
+                    if "x-timestamp" in part_headers:
+                        self.latencies.append(wall - float(part_headers["x-timestamp"]))
                     self.count += 1
                     self.bytes += len(data)
                     self.first_at = self.first_at or now

@@ -175,6 +175,16 @@ def test_a_browser_that_goes_away_releases_its_stream(live_server, image_publish
     wait_until(lambda: camera.viewers == 0, 10, "idle viewer released")
 
 
+def test_a_best_effort_camera_is_heard_without_asking_for_its_qos(live_server, image_publisher, mjpeg_client):
+    topic = "/test_cam/best_effort"
+    image_publisher(topic, width=160, height=120, hz=30, qos="sensor_data")
+    wait_listed(live_server, topic)
+    client = mjpeg_client(f"{live_server.url}/stream?topic={topic}")
+    client.wait_frames(5)  # a reliable subscription would hear nothing from a best-effort publisher
+    [(key, _, _)] = streams(live_server).producers.items()
+    assert key.qos == "sensor_data"
+
+
 def test_shutdown_ends_open_streams(live_server, mjpeg_client):
     client = mjpeg_client(f"{live_server.url}/stream?topic=/test_cam/nobody&msg_type={IMAGE}")
     wait_until(lambda: client.status == 200, 10, "stream open")
