@@ -82,17 +82,25 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=10.0)
     parser.add_argument("--viewers", type=int, nargs="*", default=[1, 5, 20])
     parser.add_argument("--quality", type=int, default=80)
+    parser.add_argument("--noise", type=float, nargs="*", default=[0.0, 12.0],
+                        help="camera grain to run with (0: the clean test pattern; 12: about a real camera's)")
     args = parser.parse_args()
+    for noise in args.noise:
+        bench(args, noise)
+
+
+def bench(args, noise: float) -> None:
     env = ros_env(ROVER_WEB_CAMERA_MAX_VIEWERS="64", ROVER_WEB_CAMERA_IDLE_TIMEOUT_S="30")
-    camera_proc = subprocess.Popen([sys.executable, "-m", "rover_web.sim.camera"], cwd=ROOT, env=env,
+    camera_proc = subprocess.Popen([sys.executable, "-m", "rover_web.sim.camera", "--camera-noise", str(noise)],
+                                   cwd=ROOT, env=env,
                                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     server = None
     try:
         server = Server(env)
         wait_for(lambda: any(t["name"] == TOPIC for t in requests.get(server.url + "/api/topics", timeout=5)
                              .json()["topics"]), 30, "camera discovery")
-        print(f"# camera bench on {machine()}: sim camera 640x480 rgb8 30 Hz (own process) -> /stream "
-              f"quality {args.quality}, {args.seconds:g} s per run", flush=True)
+        print(f"# camera bench on {machine()}: sim camera 640x480 rgb8 30 Hz, grain {noise:g} (own process) -> "
+              f"/stream quality {args.quality}, {args.seconds:g} s per run", flush=True)
         for n in args.viewers:
             r = run(server, psutil.Process(camera_proc.pid), n, args.seconds, args.quality)
             enc = r["encode_ms"] or {}

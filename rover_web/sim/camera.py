@@ -39,9 +39,12 @@ def pattern_image(width: int, height: int) -> np.ndarray:
 class PatternFrames:
     """Frame n is the pattern shifted left by n × speed pixels, with its number and time written on it."""
 
-    def __init__(self, width: int, height: int, speed_px: int = 4):
+    def __init__(self, width: int, height: int, speed_px: int = 4, noise: float = 0.0):
         self.width, self.height, self.speed_px = width, height, speed_px
         pattern = pattern_image(width, height)
+        if noise > 0:  # sensor-like grain, drawn once: JPEG then works as hard as on a real camera
+            grain = np.random.default_rng(0).normal(0.0, noise, pattern.shape)
+            pattern = np.clip(pattern + grain, 0, 255).astype(np.uint8)
         self._wide = np.concatenate([pattern, pattern], axis=1)  # any shift is one slice of this
         self._font = font(max(12, height // 24))
         self._box = (min(width, max(160, width * 3 // 5)), min(height, max(20, height // 12)))
@@ -59,9 +62,9 @@ class PatternFrames:
 
 class CameraSim(Node):
     def __init__(self, *, context=None, topic: str = "/camera/image_raw", width: int = 640, height: int = 480,
-                 rate_hz: float = 30.0, qos: str = "default", frame_id: str = "camera"):
+                 rate_hz: float = 30.0, qos: str = "default", frame_id: str = "camera", noise: float = 0.0):
         super().__init__("sim_camera", context=context)
-        self.frames = PatternFrames(width, height)
+        self.frames = PatternFrames(width, height, noise=noise)
         self.frame_id = frame_id
         self.count = 0
         self.pub = self.create_publisher(Image, topic, qos_profiles.profile(qos))
@@ -94,14 +97,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     # when any one overflows the receive buffer, which on a busy machine is a quarter of the frames.
     group.add_argument("--camera-qos", choices=("default", "sensor_data"), default="default",
                        help="publisher QoS: default (reliable) or sensor_data (best effort, as some drivers do)")
+    group.add_argument("--camera-noise", type=float, default=0.0, metavar="SIGMA",
+                       help="add fixed grain (standard deviation in grey levels) so frames compress like a real camera's")
 
 
 def from_arguments(args: argparse.Namespace, context) -> CameraSim:
     width, height = args.camera_size
-    if not (16 <= width <= 8192 and 16 <= height <= 8192) or not 0 < args.camera_hz <= 120:
-        raise SystemExit("camera: size must be 16..8192 pixels a side and --camera-hz in (0, 120]")
+    if not (16 <= width <= 8192 and 16 <= height <= 8192) or not 0 < args.camera_hz <= 120 \
+            or not 0 <= args.camera_noise <= 128:
+        raise SystemExit("camera: size must be 16..8192 pixels a side, --camera-hz in (0, 120], --camera-noise 0..128")
     return CameraSim(context=context, topic=args.camera_topic, width=width, height=height, rate_hz=args.camera_hz,
-                     qos=args.camera_qos)
+                     qos=args.camera_qos, noise=args.camera_noise)
 
 
 def main(argv: list[str] | None = None) -> None:

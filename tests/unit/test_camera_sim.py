@@ -24,3 +24,10 @@ def test_frames_move_and_carry_a_label():
     box = first[10:40, 10:200]
     assert (box == 0).mean() > 0.5 and box.max() == 255
     assert not np.array_equal(frames.frame(7, 1000.0)[10:40, 10:200], box)
+
+
+def test_grain_is_fixed_so_it_moves_with_the_pattern():
+    clean, grainy = PatternFrames(64, 48), PatternFrames(64, 48, speed_px=4, noise=12.0)
+    a, b = grainy.frame(0, 0.0), grainy.frame(1, 0.0)
+    assert np.abs(a.astype(int) - clean.frame(0, 0.0)).mean() > 3  # grain is there
+    assert np.array_equal(b[40, :-4], a[40, 4:])  # and scrolls with the pattern, costing nothing per frame
