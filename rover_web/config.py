@@ -98,6 +98,25 @@ SETTINGS: tuple[Setting, ...] = (
             "the map shows 'no pose' when the last pose is older than this; 0: never (AMCL only publishes when moving)",
             0, 3600),
     Setting("LIVEMAP_PLAN_MAX_POINTS", 500, "int", "longer paths are evenly thinned to this many points", 2, 100000),
+    # --- camera ---
+    Setting("CAMERA_TOPIC", "/camera/image_raw", "topic",
+            "image topic (sensor_msgs/Image or CompressedImage) the dashboard's camera panel shows first"),
+    Setting("CAMERA_QUALITY", 80, "int", "JPEG quality of /stream and /snapshot when the URL gives none", 1, 100),
+    Setting("CAMERA_MAX_DIMENSION", 4096, "int", "largest width or height a /stream or /snapshot may ask for",
+            16, 16384),
+    Setting("CAMERA_IDLE_TIMEOUT_S", 2.0, "float",
+            "how long an image subscription stays after its last viewer leaves (a reload reuses it)", 0.0, 600),
+    Setting("CAMERA_MAX_VIEWERS", 24, "int",
+            "most /stream and /snapshot requests served at once (503 beyond); each holds a server thread", 1, 1024),
+    Setting("CAMERA_SNAPSHOT_TIMEOUT_S", 5.0, "float", "how long /snapshot waits for a frame", 0.1, 60),
+    # --- topic browser ---
+    Setting("TOPICS_REFRESH_S", 1.0, "float", "how often the topic list (`topics` channel) is re-read from the ROS graph",
+            0.2, 60),
+    Setting("TOPICS_ECHO_HZ", 5.0, "float", "most messages a second the topic browser shows of one topic", 0.1, 50),
+    Setting("TOPICS_ECHO_MAX_ITEMS", 32, "int",
+            "arrays and byte fields longer than this are shown cut, with their length", 1, 10000),
+    Setting("TOPICS_ECHO_IDLE_TIMEOUT_S", 2.0, "float",
+            "how long a topic browser subscription stays after its last viewer leaves", 0.0, 600),
 )
 
 _BY_NAME = {PREFIX + s.name: s for s in SETTINGS}
