@@ -84,9 +84,54 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("MAP_CENTER_LNG", -82.4500873, "float", "longitude the map opens on (degrees east)", -180, 180),
     Setting("MAP_CENTER_LAT", 27.3742443, "float", "latitude the map opens on (degrees north)", -85, 85),
     Setting("MAP_ZOOM", 14.0, "float", "zoom level the map opens at", 0, 22),
-    Setting("MAP_TILES", "tiles", "optional_str",
-            "offline basemap: a z/x/y tile folder or an .mbtiles file, relative to map_files/; "
+    Setting("MAP_TILES", "map_files/tiles", "optional_str",
+            "offline basemap: a z/x/y tile folder or an .mbtiles file (relative paths from the repository root); "
             "unset or missing means no basemap"),
+    # --- panels ---
+    Setting("PANELS_FILE", None, "optional_str",
+            "TOML file defining the mission control panels; unset means the drone panel in rover_web/panels/drone.toml"),
+    Setting("PANELS_LOG_SHOWN", 20, "int", "operator-log entries a panel page shows (newest first)", 1, 500),
+    Setting("PANELS_LOG_KEEP", 10000, "int", "operator-log entries kept per panel in the database (oldest deleted)",
+            100, 10_000_000),
+    # --- livemap ---
+    Setting("MAPS_FILE", "map_files/all_maps.json", "optional_str",
+            "floorplans: an all_maps.json catalog or one map_server yaml (relative paths from the repository "
+            "root); set it empty in the environment for none"),
+    Setting("LIVEMAP_DEFAULT_MAP", None, "optional_str", "map /livemap and the dashboard show first; unset: the first one"),
+    Setting("LIVEMAP_BOT_DIAMETER_CM", 35.4, "float", "robot diameter drawn on the map (cm)", 1, 10000),
+    Setting("AMCL_POSE_TOPIC", "/amcl_pose", "topic",
+            "geometry_msgs/PoseWithCovarianceStamped robot pose in the map frame (transient local)"),
+    Setting("GOAL_TOPIC", "/goal_pose", "topic",
+            "geometry_msgs/PoseStamped goal, published by the map page and shown when others publish it "
+            "(ROS 1: /move_base_simple/goal)"),
+    Setting("GOAL_FRAME_ID", "map", "str", "frame_id of goals sent from the map page"),
+    Setting("PLAN_TOPIC", "/plan", "topic", "nav_msgs/Path drawn as the robot's route"),
+    Setting("LIVEMAP_MAP_TOPIC", None, "optional_topic",
+            "nav_msgs/OccupancyGrid (transient local, e.g. /map from SLAM) shown as the map 'live map'; unset: off"),
+    Setting("LIVEMAP_POSE_MAX_HZ", 30.0, "float", "most `pose` channel updates per second", 0.5, 200),
+    Setting("LIVEMAP_POSE_STALE_S", 5.0, "float",
+            "the map shows 'no pose' when the last pose is older than this; 0: never (AMCL only publishes when moving)",
+            0, 3600),
+    Setting("LIVEMAP_PLAN_MAX_POINTS", 500, "int", "longer paths are evenly thinned to this many points", 2, 100000),
+    # --- camera ---
+    Setting("CAMERA_TOPIC", "/camera/image_raw", "topic",
+            "image topic (sensor_msgs/Image or CompressedImage) the dashboard's camera panel shows first"),
+    Setting("CAMERA_QUALITY", 80, "int", "JPEG quality of /stream and /snapshot when the URL gives none", 1, 100),
+    Setting("CAMERA_MAX_DIMENSION", 4096, "int", "largest width or height a /stream or /snapshot may ask for",
+            16, 16384),
+    Setting("CAMERA_IDLE_TIMEOUT_S", 2.0, "float",
+            "how long an image subscription stays after its last viewer leaves (a reload reuses it)", 0.0, 600),
+    Setting("CAMERA_MAX_VIEWERS", 24, "int",
+            "most /stream and /snapshot requests served at once (503 beyond); each holds a server thread", 1, 1024),
+    Setting("CAMERA_SNAPSHOT_TIMEOUT_S", 5.0, "float", "how long /snapshot waits for a frame", 0.1, 60),
+    # --- topic browser ---
+    Setting("TOPICS_REFRESH_S", 1.0, "float", "how often the topic list (`topics` channel) is re-read from the ROS graph",
+            0.2, 60),
+    Setting("TOPICS_ECHO_HZ", 5.0, "float", "most messages a second the topic browser shows of one topic", 0.1, 50),
+    Setting("TOPICS_ECHO_MAX_ITEMS", 32, "int",
+            "arrays and byte fields longer than this are shown cut, with their length", 1, 10000),
+    Setting("TOPICS_ECHO_IDLE_TIMEOUT_S", 2.0, "float",
+            "how long a topic browser subscription stays after its last viewer leaves", 0.0, 600),
 )
 
 _BY_NAME = {PREFIX + s.name: s for s in SETTINGS}

@@ -3,7 +3,8 @@
 By default the map fetches nothing from the internet. An operator fills a local store once, while
 online, with `flask --app rover_web tiles fetch --bbox W,S,E,N --zoom A-B --url TEMPLATE`, and the
 map then shows those tiles in the field. The store is the folder or .mbtiles file named by
-ROVER_WEB_MAP_TILES (relative paths are under map_files/); the page asks only this app for tiles.
+ROVER_WEB_MAP_TILES (relative paths from the repository root, like ROVER_WEB_MAPS_FILE; default
+map_files/tiles); the page asks only this app for tiles.
 """
 
 from __future__ import annotations
@@ -25,7 +26,6 @@ from . import ROOT
 from .tile_store import (MAX_ZOOM, MEDIA_TYPES, MBTiles, TileStoreError, image_format,
                          open_tile_store, tile_count, tile_ranges, valid_tile)
 
-MAP_FILES = ROOT / "map_files"
 TILE_URL = "/tiles/{z}/{x}/{y}"
 DEFAULT_MAX_TILES = 5000
 USER_AGENT = "rover_web-tiles-fetch/0.1 (offline basemap for a robot GUI)"
@@ -38,7 +38,7 @@ def store_path(config) -> Path | None:
     if not value:
         return None
     path = Path(value).expanduser()
-    return path if path.is_absolute() else MAP_FILES / path
+    return path if path.is_absolute() else ROOT / path
 
 
 def installed_store(config):
@@ -236,7 +236,7 @@ def init_cli(app: Flask) -> None:
     @click.option("--url", "url_template", required=True,
                   help="tile server URL template with {z}, {x}, {y}, e.g. http://tiles.local/{z}/{x}/{y}.png")
     @click.option("--out", type=click.Path(), default=None,
-                  help="tile folder or .mbtiles file (default: ROVER_WEB_MAP_TILES, under map_files/)")
+                  help="tile folder or .mbtiles file (default: ROVER_WEB_MAP_TILES, map_files/tiles)")
     @click.option("--max-tiles", type=click.IntRange(1), default=DEFAULT_MAX_TILES, show_default=True,
                   help="refuse to start if the area needs more tiles than this")
     @click.option("--attribution", default="", help="credit line shown on the map, e.g. '© OpenStreetMap contributors'")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from typing import Any
 
 
@@ -76,3 +77,35 @@ def only_keys(obj: dict, allowed: set[str]) -> None:
     if unknown:
         raise InvalidInput(f"unknown field(s): {', '.join(unknown)}; allowed: {', '.join(sorted(allowed))}",
                            "unknown_field")
+
+
+_TOPIC_TOKEN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+TOPIC_MAX_LEN = 247  # rmw's limit leaves room for the DDS prefix within 255 characters
+
+
+def topic_name(value: Any, field: str = "topic") -> str:
+    """A ROS topic name, fully qualified ('camera/image' becomes '/camera/image').
+
+    The rules of rmw_validate_full_topic_name: '/'-separated tokens of letters, digits and '_',
+    none starting with a digit, no empty token, no trailing '/'. Substitutions ('~', '{node}')
+    mean nothing to a browser and are refused.
+    """
+    if not isinstance(value, str) or not value.strip():
+        raise InvalidInput(f"'{field}' is required: a ROS topic name such as /camera/image_raw", "missing_field")
+    name = value.strip()
+    if len(name) > TOPIC_MAX_LEN:
+        raise InvalidInput(f"'{field}' is longer than {TOPIC_MAX_LEN} characters", "bad_topic")
+    if not name.startswith("/"):
+        name = "/" + name
+    tokens = name[1:].split("/")
+    for token in tokens:
+        if not _TOPIC_TOKEN.match(token):
+            shown = value.strip()[:80]
+            if token == "":
+                why = "has an empty part ('//' or a trailing '/')"
+            elif token[0].isdigit():
+                why = f"has a part starting with a digit ({token[:20]!r})"
+            else:
+                why = "may only contain letters, digits, '_' and '/'"
+            raise InvalidInput(f"'{field}' {shown!r} is not a valid ROS topic name: it {why}", "bad_topic")
+    return name

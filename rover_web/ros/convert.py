@@ -29,15 +29,24 @@ def _plain(value: Any, max_items: int | None) -> Any:
     if isinstance(value, float):
         # JSON has no NaN or Infinity; show them as text rather than lose the message.
         return value if math.isfinite(value) else str(value)
-    if isinstance(value, (bytes, bytearray)):
-        value = list(value)
-    elif isinstance(value, array.array) or type(value).__module__ == "numpy":
-        value = value.tolist()
-    if isinstance(value, (list, tuple)):
-        if max_items is not None and len(value) > max_items:
-            return {"truncated": True, "length": len(value),
-                    "head": [_plain(v, max_items) for v in value[:max_items]]}
-        return [_plain(v, max_items) for v in value]
+    if isinstance(value, bytes) and len(value) == 1:
+        return value[0]  # rclpy gives a `byte` (alone or in a byte[]) as a one-byte bytes object
+    if isinstance(value, (bytes, bytearray, array.array, list, tuple)) or type(value).__module__ == "numpy":
+        if type(value).__module__ == "numpy" and getattr(value, "ndim", 1) == 0:
+            return _plain(value.item(), max_items)
+        # Cut before converting: an image's data is a million-element array, and turning all of
+        # it into Python ints only to keep the first few costs tens of milliseconds per message.
+        length = len(value)
+        head = value if max_items is None or length <= max_items else value[:max_items]
+        if isinstance(head, (bytes, bytearray)):
+            items = list(head)
+        elif isinstance(head, array.array) or type(head).__module__ == "numpy":
+            items = [_plain(v, max_items) for v in head.tolist()]  # floats may be NaN
+        else:
+            items = [_plain(v, max_items) for v in head]
+        if len(head) < length:
+            return {"truncated": True, "length": length, "head": items}
+        return items
     return value
 
 

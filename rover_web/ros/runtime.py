@@ -88,7 +88,8 @@ class RosRuntime:
             self.executor.shutdown(timeout_sec=timeout_s)
         except Exception:
             log.exception("executor shutdown failed")
-        self._thread.join(timeout_s)
+        if self._thread.ident is not None:  # a feature's init_app may fail before start()
+            self._thread.join(timeout_s)
         try:
             self.node.destroy_node()
         finally:
@@ -115,8 +116,12 @@ class RosRuntime:
         return self.node.create_publisher(cls, topic, self._qos(qos))
 
     def subscribe(self, msg_type: str | type, topic: str, callback: Callable[[Any], None],
-                  qos: str | int = "default", *, track: bool = True):
-        """Subscribe with an exception-safe callback; `track` adds the topic to /api/status."""
+                  qos: str | int = "default", *, track: bool = True, raw: bool = False):
+        """Subscribe with an exception-safe callback; `track` adds the topic to /api/status.
+
+        `raw` hands the callback the serialized message (bytes) instead of deserializing it, for
+        code that measures bandwidth or decodes only some messages.
+        """
         cls = message_class(msg_type) if isinstance(msg_type, str) else msg_type
         stats = None
         if track:
@@ -131,7 +136,7 @@ class RosRuntime:
                 self.callback_errors += 1
                 log.exception("callback for %s failed", topic)
 
-        return self.node.create_subscription(cls, topic, guarded, self._qos(qos))
+        return self.node.create_subscription(cls, topic, guarded, self._qos(qos), raw=raw)
 
     def destroy(self, entity) -> None:
         """Destroy a publisher or subscription made through this runtime."""

@@ -1,0 +1,83 @@
+"""The camera panel and the topic page in a real Chromium, against the simulator in its own process."""
+
+import time
+
+import pytest
+
+pytestmark = pytest.mark.browser
+
+
+def image_loaded(page):
+    return page.evaluate("() => { const i = document.getElementById('camera-image');"
+                         " return i.complete && i.naturalWidth; }")
+
+
+def test_camera_panel_shows_moving_frames_from_the_simulator(live_server, sim_process, page):
+    sim_process()
+    page.goto(live_server.url + "/")
+    page.wait_for_selector("#link-server[data-state='live']", timeout=10000)
+    deadline = time.monotonic() + 20
+    while image_loaded(page) != 640:
+        assert time.monotonic() < deadline, page.locator("#camera-message").inner_text()
+        page.wait_for_timeout(200)
+    assert page.locator("#camera-topic").input_value() == "/camera/image_raw"
+    image = page.locator("#camera-image")
+    first = image.screenshot()
+    page.wait_for_timeout(1000)
+    second = image.screenshot()
+    assert first != second  # the pattern moves and the frame counter changes
+    assert page.locator("#camera-message").is_hidden()
+    # An endless MJPEG response must not keep other pages' tests from reaching network idle.
+    page.wait_for_load_state("networkidle", timeout=10000)
+    assert page.watch.offhost == [] and page.watch.console_errors == []
+
+
+def test_camera_panel_without_a_camera_says_so_without_failed_requests(live_server, page):
+    page.goto(live_server.url + "/")
+    page.wait_for_selector("#camera-message:not([hidden])", timeout=10000)
+    assert "no image topic /camera/image_raw" in page.locator("#camera-message").inner_text()
+    page.wait_for_load_state("networkidle")
+    assert page.watch.console_errors == [] and page.watch.offhost == []
+    assert live_server.app.extensions["rover_web_camera"].viewers == 0
+
+
+def test_hidden_tab_drops_the_stream(live_server, sim_process, page):
+    sim_process()
+    page.goto(live_server.url + "/")
+    camera = live_server.app.extensions["rover_web_camera"]
+    deadline = time.monotonic() + 20
+    while camera.viewers != 1:
+        assert time.monotonic() < deadline, page.locator("#camera-message").inner_text()
+        page.wait_for_timeout(100)  # not time.sleep: requests wait for Playwright to route them
+    page.evaluate("() => { Object.defineProperty(document, 'hidden', {value: true, configurable: true});"
+                  " document.dispatchEvent(new Event('visibilitychange')); }")
+    deadline = time.monotonic() + 10
+    while camera.viewers != 0:
+        assert time.monotonic() < deadline, "the hidden page kept its stream"
+        page.wait_for_timeout(100)  # not time.sleep: requests wait for Playwright to route them
+
+
+def test_topic_page_lists_the_simulators_topics_and_echoes_one(live_server, sim_process, page):
+    sim_process()
+    page.goto(live_server.url + "/topics")
+    for name, type_name in (("/camera/image_raw", "sensor_msgs/msg/Image"), ("/odom", "nav_msgs/msg/Odometry"),
+                            ("/fix", "sensor_msgs/msg/NavSatFix"), ("/amcl_pose",
+                                                                    "geometry_msgs/msg/PoseWithCovarianceStamped")):
+        row = page.locator(f"#topics-body tr[data-topic='{name}']")
+        row.wait_for(timeout=15000)
+        assert type_name in row.inner_text()
+    page.locator("#topics-body a[data-topic='/odom']").click()
+    page.wait_for_function("document.getElementById('echo-msg').textContent.includes('child_frame_id')",
+                           timeout=15000)
+    assert '"base_link"' in page.locator("#echo-msg").inner_text()
+    page.wait_for_function("parseFloat(document.getElementById('echo-rate').textContent) > 30", timeout=15000)
+    assert page.locator("#echo-type").inner_text() == "nav_msgs/msg/Odometry"
+    assert "/topics?topic=%2Fodom" in page.url
+    # Filtering narrows the list.
+    page.fill("#topics-filter", "navsat")
+    page.wait_for_function("document.querySelectorAll('#topics-body tr').length === 1")
+    # An image topic offers its video stream.
+    page.fill("#topics-filter", "")
+    page.locator("#topics-body a[data-topic='/camera/image_raw']").click()
+    page.wait_for_selector("#echo-stream:not([hidden])", timeout=15000)
+    assert page.watch.offhost == [] and page.watch.console_errors == []
