@@ -22,6 +22,8 @@ def open_map(page, url):
     page.goto(url + "/")
     page.wait_for_selector("#wp-map[data-ready='yes']", timeout=30000)
     page.wait_for_selector("#link-server[data-state='live']", timeout=10000)
+    page.locator("#waypoints-card").scroll_into_view_if_needed()  # other panels may come first
+    page.wait_for_timeout(200)
 
 
 def unproject(page, x, y):
@@ -115,7 +117,7 @@ def test_click_adds_drag_moves_delete_removes_and_other_browsers_follow(live_ser
 
 
 def test_the_simulated_robot_moves_on_the_map(live_server, sim_process, ros_peer, page):
-    sim_process()
+    sim_process("--start", "0", "0", "0")  # at the GPS origin (Nathan Benderson Park), facing east
     open_map(page, live_server.url)
     page.wait_for_selector("#wp-fix[data-fix='yes']", timeout=20000)
     page.wait_for_selector(".wp-robot")
