@@ -17,6 +17,7 @@ import argparse
 import http.client
 import json
 import os
+import shutil
 import sqlite3
 import statistics
 import subprocess
@@ -184,6 +185,7 @@ def main() -> None:
     finally:
         peer.close()
         server.stop()
+        shutil.rmtree(work, ignore_errors=True)
 
 
 if __name__ == "__main__":
