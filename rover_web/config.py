@@ -71,6 +71,19 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("CMD_VEL_FRAME_ID", "base_link", "str", "frame_id of TwistStamped commands"),
     Setting("MAX_LINEAR_MPS", 5.0, "float", "linear speed at full joystick deflection (m/s)", 0.0, 100),
     Setting("MAX_ANGULAR_RPS", 2.0, "float", "turn rate at full joystick deflection (rad/s)", 0.0, 100),
+    Setting("TELEOP_RATE_HZ", 40.0, "float",
+            "rate at which the server republishes the held joystick/keyboard/REST command on the velocity topic", 1, 200),
+    Setting("TELEOP_DEADMAN_S", 0.3, "float",
+            "a joystick/keyboard command with no fresh input for this long is stopped (zero published)", 0.05, 5),
+    Setting("TELEOP_MAX_FRAME_BYTES", 4096, "int",
+            "largest teleop WebSocket frame; a bigger one closes the socket with 1009", 256, 65536),
+    Setting("TELEOP_WS_PING_S", 10.0, "float",
+            "teleop WebSocket ping interval; a client that misses a pong loses the socket and control (0: off)", 0, 300),
+    Setting("TELEOP_REST_DEFAULT_SPEED", 0.2, "float",
+            "speed of POST /api/teleop without `speed`, as a fraction of the maxima", 0, 1),
+    Setting("TELEOP_REST_DEFAULT_DURATION_S", 0.5, "float",
+            "how long POST /api/teleop drives without `duration_s` before it stops by itself", 0.01, 60),
+    Setting("TELEOP_REST_MAX_DURATION_S", 5.0, "float", "longest `duration_s` POST /api/teleop accepts", 0.01, 60),
 )
 
 _BY_NAME = {PREFIX + s.name: s for s in SETTINGS}
