@@ -85,6 +85,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     require_rclpy()
     from .core import Rover
     from .db import Database, database_path
+    from .sse_broadcast import Broadcaster
     from .motion import CmdVelOutput
     from .ros.runtime import RosRuntime
 
@@ -97,6 +98,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
                                frame_id=settings["ROVER_WEB_CMD_VEL_FRAME_ID"])
         hub = EventHub(max_clients=settings["ROVER_WEB_SSE_MAX_CLIENTS"])
         rover = Rover(settings, hub, runtime, cmd_vel)
+        rover.broadcaster = Broadcaster(hub, settings["ROVER_WEB_SSE_KEEPALIVE_S"])
         rover.db = Database(database_path(app))
         rover.on_shutdown(rover.db.close)
         app.extensions["rover_web"] = rover

@@ -64,6 +64,7 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("LINK_TOPICS", ["/odom"], "list",
             "topics whose freshness defines the server-robot link in the health bar"),
     Setting("ODOM_TOPIC", "/odom", "topic", "nav_msgs/Odometry the dashboard shows speed from"),
+    Setting("ODOM_MAX_HZ", 10.0, "float", "most `odom` channel updates a second sent to browsers", 0.1, 1000),
     # --- teleop ---
     Setting("CMD_VEL_TOPIC", "/cmd_vel", "topic", "velocity command topic"),
     Setting("CMD_VEL_STAMPED", False, "bool",

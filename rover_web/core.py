@@ -31,6 +31,7 @@ class Rover:
         self.runtime = runtime
         self.cmd_vel = cmd_vel
         self.db = None  # rover_web.db.Database, opened by create_app
+        self.broadcaster = None  # rover_web.sse_broadcast.Broadcaster, writes every SSE stream
         self.dashboard_panels: list[DashboardPanel] = []
         self.nav_links: list[tuple[str, str]] = [("Dashboard", "/")]
         self._shutdown_hooks: list[Callable[[], None]] = []

@@ -44,6 +44,7 @@ class EventHub:
         self._max_clients = max_clients
         self._closed = False
         self._throttle: dict[str, list] = {}  # channel -> [last publish time, pending value, timer]
+        self._listeners: list = []
 
     # --- producers ---
 
@@ -62,6 +63,7 @@ class EventHub:
             self._seq += 1
             self._latest[channel] = (self._seq, sse_frame(self._seq, channel, payload), data)
             self._cond.notify_all()
+            self._notify_listeners()
             return self._seq
 
     def publish_throttled(self, channel: str, data: Any, max_hz: float) -> None:
@@ -102,7 +104,17 @@ class EventHub:
             self._seq += 1
             self._ring.append((self._seq, channel, sse_frame(self._seq, channel, payload)))
             self._cond.notify_all()
+            self._notify_listeners()
             return self._seq
+
+    def add_listener(self, wake) -> None:
+        """`wake()` is called (under the hub lock, so it must be quick) after every change and on close."""
+        with self._cond:
+            self._listeners.append(wake)
+
+    def _notify_listeners(self) -> None:
+        for wake in self._listeners:
+            wake()
 
     def latest(self, channel: str) -> Any:
         with self._cond:
@@ -114,6 +126,7 @@ class EventHub:
         with self._cond:
             self._closed = True
             self._cond.notify_all()
+            self._notify_listeners()
 
     # --- consumers ---
 
@@ -174,9 +187,15 @@ class Subscription:
                 hub._cond.wait(timeout_s)
             if hub._closed:
                 return None
-            if hub._seq == self._cursor:
-                return b""
+            return self.poll()
+
+    def poll(self) -> bytes:
+        """Frames that changed since the last call, without waiting (b"" if nothing changed)."""
+        hub = self._hub
+        with hub._cond:
             cursor = self._cursor
+            if hub._seq == cursor:
+                return b""
             frames = [(seq, frame) for ch, (seq, frame, _) in hub._latest.items()
                       if seq > cursor and ch in self.channels]
             for seq, ch, frame in reversed(hub._ring):

@@ -80,6 +80,10 @@ def _guard():
         if origin and not origin_allowed(origin, host, config["ROVER_WEB_ALLOWED_ORIGINS"]):
             return error_response(403, "foreign_origin",
                                   f"requests from {origin[:80]} may not control this robot; add it to ROVER_WEB_ALLOWED_ORIGINS")
+    limit = config["ROVER_WEB_MAX_BODY_BYTES"]
+    if request.content_length is not None and request.content_length > limit:
+        # Refuse before routing or reading, whatever the route does with its body.
+        return error_response(413, "request_entity_too_large", f"request body is larger than {limit} bytes")
     if request.method in ("POST", "PUT", "PATCH") and request.mimetype != "application/json":
         return error_response(415, "unsupported_media_type",
                               "send the body as JSON with the header Content-Type: application/json")

@@ -40,6 +40,31 @@ def _parse_channels(raw: str, known: frozenset[str]) -> list[str]:
     return channels
 
 
+_SEND_BUFFER_BYTES = 64 * 1024
+_HEAD = (b"HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-cache\r\n"
+         b"X-Accel-Buffering: no\r\nConnection: close\r\n\r\n")
+
+
+def _serve_on_socket(rover, sock, subscription, retry: bytes) -> Response:
+    """Write the head and snapshot here, then let the Broadcaster own the stream until it ends.
+
+    The body is delimited by closing the connection (no chunked framing), and this thread only
+    waits, so the server does not reuse or close the socket while the Broadcaster writes to it.
+    """
+    try:
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        # A small kernel buffer bounds what a stalled browser can hold up; the rest is conflated.
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, _SEND_BUFFER_BYTES)
+        sock.sendall(_HEAD + retry + subscription.snapshot())
+    except OSError:
+        subscription.close()
+        return Response(status=204)
+    rover.broadcaster.attach(sock, subscription).wait()
+    # The server will try to send a response on the shut-down socket and treat it as a dropped
+    # connection; nothing reaches the browser.
+    return Response(status=204)
+
+
 @bp.get("/api/events")
 def events():
     rover = current_rover()
@@ -57,6 +82,8 @@ def events():
     keepalive_s = config["ROVER_WEB_SSE_KEEPALIVE_S"]
     sock = request.environ.get("werkzeug.socket") or request.environ.get("gunicorn.socket")
     retry = f"retry: {config['ROVER_WEB_SSE_RETRY_MS']}\n\n".encode()
+    if sock is not None and request.environ.get("SERVER_PROTOCOL", "").startswith("HTTP/1."):
+        return _serve_on_socket(rover, sock, subscription, retry)
 
     def stream():
         with subscription:

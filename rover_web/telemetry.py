@@ -5,11 +5,7 @@ from __future__ import annotations
 import math
 
 from .core import Rover
-from .ros.convert import yaw_from_quaternion
-
-# Odometry often arrives at 50-100 Hz; a person reads a speed at a few Hz.
-ODOM_CHANNEL_MAX_HZ = 10.0
-
+from .ros.convert import stamp_to_float, yaw_from_quaternion
 
 def odom_summary(msg) -> dict:
     pose, twist = msg.pose.pose, msg.twist.twist
@@ -21,16 +17,19 @@ def odom_summary(msg) -> dict:
         "linear": round(twist.linear.x, 3),
         "angular": round(twist.angular.z, 3),
         "frame_id": msg.header.frame_id,
+        "stamp": stamp_to_float(msg.header.stamp),
     }
 
 
 def init_app(app, rover: Rover) -> None:
     rover.hub.register("odom")
+    # Odometry often arrives at 50-100 Hz; a person reads a speed at a few Hz.
+    max_hz = rover.config["ROVER_WEB_ODOM_MAX_HZ"]
 
     def on_odom(msg) -> None:
         summary = odom_summary(msg)
         if all(isinstance(v, str) or math.isfinite(v) for v in summary.values()):  # a NaN pose is not shown
-            rover.hub.publish_throttled("odom", summary, ODOM_CHANNEL_MAX_HZ)
+            rover.hub.publish_throttled("odom", summary, max_hz)
 
     rover.runtime.subscribe("nav_msgs/msg/Odometry", rover.config["ROVER_WEB_ODOM_TOPIC"], on_odom, qos=10)
     rover.add_panel(10, "panels/odom.html", "Robot", channels=("odom",))

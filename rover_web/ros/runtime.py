@@ -1,4 +1,4 @@
-"""RosRuntime: one private rclpy Context, one Node, one MultiThreadedExecutor on a daemon thread.
+"""RosRuntime: one private rclpy Context, one Node, one executor on a daemon thread.
 
 Request threads never spin: they publish directly (rclpy publishers are thread-safe) or hand work
 to the executor with `run_on_executor`. Subscription callbacks are wrapped so that an exception in
@@ -15,7 +15,7 @@ from typing import Any, Callable
 
 import rclpy
 from rclpy.context import Context
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import get_rmw_implementation_identifier
 
@@ -27,7 +27,7 @@ log = logging.getLogger(__name__)
 
 
 class RosRuntime:
-    def __init__(self, node_name: str, domain_id: int | None = None, executor_threads: int = 4):
+    def __init__(self, node_name: str, domain_id: int | None = None):
         self.context = Context()
         # rclpy must not install its own SIGINT handler: the process decides how to stop (robot first).
         rclpy.init(context=self.context, domain_id=domain_id,
@@ -37,7 +37,12 @@ class RosRuntime:
         except Exception:
             self.context.try_shutdown()
             raise
-        self.executor = MultiThreadedExecutor(num_threads=executor_threads, context=self.context)
+        # One executor thread, SingleThreadedExecutor. rclpy 7.1.6's MultiThreadedExecutor busy-spins
+        # while a mutually exclusive callback is in flight: measured with 100 Hz odometry it took 53%
+        # of a core and lost 37% of the messages, against 6.7% and none lost here (BENCHMARKS.md).
+        # Callbacks only update domain objects and the EventHub; slow work (JPEG encoding, map
+        # rendering) runs on worker threads, so nothing needs a second executor thread.
+        self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         self._thread = threading.Thread(target=self._spin, name="ros-executor", daemon=True)
         self._stats: dict[str, TopicStats] = {}
