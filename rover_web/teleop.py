@@ -138,8 +138,8 @@ def teleop_socket(ws) -> None:
     stopping = current_app.extensions["rover_web"].stopping
     session = controller.connect(_name(request.args.get("name")))
     try:
-        _send(ws, {"type": "hello", "session": session.id, "name": session.name, **teleop.hello(),
-                   **controller.session_state(session, "connected")})
+        _send(ws, {**controller.session_state(session, "connected"), "type": "hello", "session": session.id,
+                   "name": session.name, **teleop.hello()})
         while not stopping.is_set():
             data = ws.receive(timeout=SOCKET_POLL_S)
             if data is not None:
@@ -234,7 +234,7 @@ def init_app(app, rover: Rover) -> None:
     app.config["SOCK_SERVER_OPTIONS"] = {"max_message_size": teleop.max_frame_bytes,
                                          "ping_interval": ping_s or None}
     sock = Sock(app)
-    sock.route("/ws/teleop", bp=bp)(teleop_socket)
+    sock.route("/ws/teleop")(teleop_socket)  # on the app: the module's blueprint is shared by every app
     app.register_blueprint(bp)
 
     rover.hub.register(CHANNEL)

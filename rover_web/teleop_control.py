@@ -153,10 +153,11 @@ class TeleopController:
             if self._holder is session:
                 return
             previous = self._holder
-            if self._command is not None:
-                self._stop("taken_over", bump=[previous] if previous else ())
             self._holder = session
+            if self._command is not None:
+                self._stop("taken_over")
             if previous is not None:
+                previous.epoch += 1  # frames it still had in flight are stale
                 self._tell(previous, "taken_over")
             self._tell(session, "in_control")
             self._changed()
