@@ -216,8 +216,9 @@ function start() {
     text('teleop-angular', s.angular_rps.toFixed(2));
     text('teleop-source', s.source || '');
     text('teleop-last-stop', s.last_stop ? s.last_stop.reason.replace('_', ' ') : '—');
-    holder = s.holder;
-    inControl = Boolean(session && s.holder && s.holder.id === session);
+    // Who holds control, for display and for claiming a free robot. Whether *this* socket holds it
+    // comes from the socket itself: an SSE update can be a little older than the socket's news.
+    if (!inControl) holder = s.holder;
     estop = s.estop.engaged;
     render();
   });
