@@ -215,7 +215,7 @@ function start() {
     text('teleop-linear', s.linear_mps.toFixed(2));
     text('teleop-angular', s.angular_rps.toFixed(2));
     text('teleop-source', s.source || '');
-    text('teleop-last-stop', s.last_stop ? s.last_stop.reason.replace('_', ' ') : '—');
+    text('teleop-last-stop', s.last_stop ? s.last_stop.reason.replaceAll('_', ' ') : '—');
     // Who holds control, for display and for claiming a free robot. Whether *this* socket holds it
     // comes from the socket itself: an SSE update can be a little older than the socket's news.
     if (!inControl) holder = s.holder;
