@@ -8,7 +8,7 @@ import os
 bind = f"{os.environ.get('ROVER_WEB_HOST', '127.0.0.1')}:{os.environ.get('ROVER_WEB_PORT', '5000')}"
 workers = 1  # every worker would be a separate ROS node; never raise this
 worker_class = "gthread"
-threads = 32  # each SSE stream and the teleop WebSocket hold a thread
+threads = 64  # each open page holds one thread (its SSE stream) plus one per WebSocket
 timeout = 0  # event streams are long-lived by design
 graceful_timeout = 5
 

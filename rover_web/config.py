@@ -85,6 +85,32 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("TELEOP_REST_DEFAULT_DURATION_S", 0.5, "float",
             "how long POST /api/teleop drives without `duration_s` before it stops by itself", 0.01, 60),
     Setting("TELEOP_REST_MAX_DURATION_S", 5.0, "float", "longest `duration_s` POST /api/teleop accepts", 0.01, 60),
+    # --- panels ---
+    Setting("PANELS_FILE", None, "optional_str",
+            "TOML file defining the mission control panels; unset means the drone panel in rover_web/panels/drone.toml"),
+    Setting("PANELS_LOG_SHOWN", 20, "int", "operator-log entries a panel page shows (newest first)", 1, 500),
+    Setting("PANELS_LOG_KEEP", 10000, "int", "operator-log entries kept per panel in the database (oldest deleted)",
+            100, 10_000_000),
+    # --- livemap ---
+    Setting("MAPS_FILE", "map_files/all_maps.json", "optional_str",
+            "floorplans: an all_maps.json catalog or one map_server yaml (relative paths from the repository "
+            "root); set it empty in the environment for none"),
+    Setting("LIVEMAP_DEFAULT_MAP", None, "optional_str", "map /livemap and the dashboard show first; unset: the first one"),
+    Setting("LIVEMAP_BOT_DIAMETER_CM", 35.4, "float", "robot diameter drawn on the map (cm)", 1, 10000),
+    Setting("AMCL_POSE_TOPIC", "/amcl_pose", "topic",
+            "geometry_msgs/PoseWithCovarianceStamped robot pose in the map frame (transient local)"),
+    Setting("GOAL_TOPIC", "/goal_pose", "topic",
+            "geometry_msgs/PoseStamped goal, published by the map page and shown when others publish it "
+            "(ROS 1: /move_base_simple/goal)"),
+    Setting("GOAL_FRAME_ID", "map", "str", "frame_id of goals sent from the map page"),
+    Setting("PLAN_TOPIC", "/plan", "topic", "nav_msgs/Path drawn as the robot's route"),
+    Setting("LIVEMAP_MAP_TOPIC", None, "optional_topic",
+            "nav_msgs/OccupancyGrid (transient local, e.g. /map from SLAM) shown as the map 'live map'; unset: off"),
+    Setting("LIVEMAP_POSE_MAX_HZ", 30.0, "float", "most `pose` channel updates per second", 0.5, 200),
+    Setting("LIVEMAP_POSE_STALE_S", 5.0, "float",
+            "the map shows 'no pose' when the last pose is older than this; 0: never (AMCL only publishes when moving)",
+            0, 3600),
+    Setting("LIVEMAP_PLAN_MAX_POINTS", 500, "int", "longer paths are evenly thinned to this many points", 2, 100000),
 )
 
 _BY_NAME = {PREFIX + s.name: s for s in SETTINGS}

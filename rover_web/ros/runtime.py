@@ -88,7 +88,7 @@ class RosRuntime:
             self.executor.shutdown(timeout_sec=timeout_s)
         except Exception:
             log.exception("executor shutdown failed")
-        if self._thread.ident is not None:  # a feature that failed in create_app stops it unstarted
+        if self._thread.ident is not None:  # a feature's init_app may fail before start()
             self._thread.join(timeout_s)
         try:
             self.node.destroy_node()

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import argparse
 
-from . import rover
+from . import drone, rover
 from .runner import run_nodes
 
 # Each part: add_arguments(parser) and from_arguments(args, context) -> Node.
-PARTS = (rover,)
+PARTS = (rover, drone)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -3,22 +3,30 @@
 Like a real base it stops by itself when commands stop for `cmd_timeout_s`. Its GPS fix is its
 map pose laid on a local tangent plane around a configurable origin (by default Nathan
 Benderson Park, Sarasota, FL, where RobotX is held).
+
+It starts on the first floorplan of map_files/all_maps.json (at that map's first waypoint) and
+drives itself to a goal received on /goal_pose (frame `map`) with a simple turn-and-drive
+controller, publishing a straight-line /plan while it goes, and stops there. The operator always
+wins: any /cmd_vel message, a stop included, cancels the goal, as a stop button would on a
+navigating robot.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+import os
 import time
+from dataclasses import dataclass
 
 import rclpy
-from geometry_msgs.msg import PoseWithCovarianceStamped, Twist, TwistStamped
-from nav_msgs.msg import Odometry
+from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, Twist, TwistStamped
+from nav_msgs.msg import Odometry, Path
 from rclpy.node import Node
 from sensor_msgs.msg import NavSatFix, NavSatStatus
 
 from ..ros import qos
-from ..ros.convert import quaternion_from_yaw
+from ..ros.convert import quaternion_from_yaw, yaw_from_quaternion
 
 EARTH_RADIUS_M = 6378137.0
 BENDERSON_LAT = 27.3742443
@@ -64,12 +72,86 @@ class DiffDrive:
             self.yaw = math.atan2(math.sin(new_yaw), math.cos(new_yaw))
 
 
+def _wrap(angle: float) -> float:
+    return math.atan2(math.sin(angle), math.cos(angle))
+
+
+@dataclass(frozen=True)
+class Goal:
+    x: float
+    y: float
+    yaw: float
+
+
+class GoalFollower:
+    """Turn towards the goal, drive to it, turn to its heading, stop. Pure, so it is unit-tested.
+
+    Linear speed falls with the heading error (nothing while facing more than 60 degrees away) and
+    with the distance left, so the robot arcs in without overshooting; once within
+    `position_tolerance_m` it only turns, and it never drives off again for the same goal.
+    """
+
+    def __init__(self, max_linear_mps: float = 0.5, max_angular_rps: float = 1.0,
+                 position_tolerance_m: float = 0.05, yaw_tolerance_rad: float = 0.05,
+                 linear_gain: float = 1.0, angular_gain: float = 2.0):
+        self.max_linear_mps, self.max_angular_rps = max_linear_mps, max_angular_rps
+        self.position_tolerance_m, self.yaw_tolerance_rad = position_tolerance_m, yaw_tolerance_rad
+        self.linear_gain, self.angular_gain = linear_gain, angular_gain
+        self.goal: Goal | None = None
+        self._turning_in_place = False
+        self.reached = 0  # goals completed, for logs and tests
+
+    @property
+    def active(self) -> bool:
+        return self.goal is not None
+
+    def set_goal(self, x: float, y: float, yaw: float) -> bool:
+        if not all(math.isfinite(v) for v in (x, y, yaw)):
+            return False
+        self.goal = Goal(x, y, _wrap(yaw))
+        self._turning_in_place = False
+        return True
+
+    def cancel(self) -> bool:
+        """Forget the goal; True if there was one."""
+        had = self.goal is not None
+        self.goal = None
+        return had
+
+    def command(self, x: float, y: float, yaw: float) -> tuple[float, float]:
+        """(linear m/s, angular rad/s) towards the goal from pose (x, y, yaw); (0, 0) once there."""
+        goal = self.goal
+        if goal is None:
+            return 0.0, 0.0
+        dx, dy = goal.x - x, goal.y - y
+        distance = math.hypot(dx, dy)
+        if not self._turning_in_place and distance <= self.position_tolerance_m:
+            self._turning_in_place = True
+        if self._turning_in_place:
+            error = _wrap(goal.yaw - yaw)
+            if abs(error) <= self.yaw_tolerance_rad:
+                self.goal = None
+                self.reached += 1
+                return 0.0, 0.0
+            return 0.0, self._clamp(self.angular_gain * error, self.max_angular_rps)
+        error = _wrap(math.atan2(dy, dx) - yaw)
+        angular = self._clamp(self.angular_gain * error, self.max_angular_rps)
+        facing = max(0.0, (math.cos(error) - 0.5) / 0.5)  # 1 facing the goal, 0 at 60 degrees or more
+        linear = min(self.max_linear_mps, self.linear_gain * distance) * facing
+        return linear, angular
+
+    @staticmethod
+    def _clamp(value: float, limit: float) -> float:
+        return max(-limit, min(limit, value))
+
+
 class RoverSim(Node):
     def __init__(self, *, context=None, x: float = 0.0, y: float = 0.0, yaw: float = 0.0,
                  stamped: bool = False, lat0: float = BENDERSON_LAT, lon0: float = BENDERSON_LON,
-                 rate_hz: float = 50.0):
+                 rate_hz: float = 50.0, goal_topic: str = "/goal_pose", goal_speed_mps: float = 0.5):
         super().__init__("sim_rover", context=context)
         self.drive = DiffDrive(x, y, yaw)
+        self.follower = GoalFollower(max_linear_mps=goal_speed_mps)
         self.lat0, self.lon0 = lat0, lon0
         if stamped:
             self.create_subscription(TwistStamped, "/cmd_vel", lambda m: self._on_cmd(m.twist), 10)
@@ -78,16 +160,40 @@ class RoverSim(Node):
         self.odom_pub = self.create_publisher(Odometry, "/odom", 10)
         self.pose_pub = self.create_publisher(PoseWithCovarianceStamped, "/amcl_pose", qos.profile("latched"))
         self.fix_pub = self.create_publisher(NavSatFix, "/fix", 10)
+        self.plan_pub = self.create_publisher(Path, "/plan", 1)
+        self.create_subscription(PoseStamped, goal_topic, self._on_goal, 10)
         self._dt = 1.0 / rate_hz
         self._ticks = 0
         self._last = time.monotonic()
         self.create_timer(self._dt, self._tick)
 
     def _on_cmd(self, twist) -> None:
+        if self.follower.cancel():
+            self.get_logger().info("operator command on /cmd_vel: goal cancelled")
+            self.plan_pub.publish(self._plan(None))
         self.drive.command(twist.linear.x, twist.angular.z, time.monotonic())
+
+    def _on_goal(self, msg: PoseStamped) -> None:
+        if msg.header.frame_id not in ("map", ""):
+            self.get_logger().warning(f"ignoring a goal in frame {msg.header.frame_id!r}; the sim drives in 'map'")
+            return
+        q = msg.pose.orientation
+        x, y = msg.pose.position.x, msg.pose.position.y
+        if self.follower.set_goal(x, y, yaw_from_quaternion(q.x, q.y, q.z, q.w)):
+            self.get_logger().info(f"goal ({x:.2f}, {y:.2f}) received")
+            self.plan_pub.publish(self._plan(self.follower.goal))
 
     def _tick(self) -> None:
         now = time.monotonic()
+        if self.follower.active:
+            d = self.drive
+            linear, angular = self.follower.command(d.x, d.y, d.yaw)
+            d.command(linear, angular, now)
+            if not self.follower.active:
+                self.get_logger().info(f"goal reached at ({d.x:.2f}, {d.y:.2f})")
+                self.plan_pub.publish(self._plan(None))
+            elif self._ticks % 50 == 0:  # a planner republishes its path; ours shrinks as we go
+                self.plan_pub.publish(self._plan(self.follower.goal))
         self.drive.step(now - self._last, now)
         self._last = now
         self._ticks += 1
@@ -125,6 +231,23 @@ class RoverSim(Node):
         msg.pose.covariance = cov
         return msg
 
+    def _plan(self, goal: Goal | None) -> Path:
+        """A straight line from here to the goal, or an empty path once there is none."""
+        msg = Path()
+        msg.header.stamp = self.get_clock().now().to_msg()
+        msg.header.frame_id = "map"
+        if goal is not None:
+            d = self.drive
+            steps = max(1, int(math.hypot(goal.x - d.x, goal.y - d.y) / 0.25))
+            for i in range(steps + 1):
+                pose = PoseStamped()
+                pose.header = msg.header
+                pose.pose.position.x = d.x + (goal.x - d.x) * i / steps
+                pose.pose.position.y = d.y + (goal.y - d.y) * i / steps
+                pose.pose.orientation.w = 1.0
+                msg.poses.append(pose)
+        return msg
+
     def _fix(self, stamp) -> NavSatFix:
         lat, lon = enu_to_geodetic(self.drive.x, self.drive.y, self.lat0, self.lon0)
         msg = NavSatFix()
@@ -142,12 +265,29 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("rover")
     group.add_argument("--stamped", action="store_true", help="expect geometry_msgs/TwistStamped on /cmd_vel")
     group.add_argument("--start", type=float, nargs=3, metavar=("X", "Y", "YAW"), default=None,
-                       help="start pose in the map frame (metres, radians)")
+                       help="start pose in the map frame (metres, radians); default: the first waypoint "
+                            "of the first map in --maps-file")
+    group.add_argument("--maps-file", default=None,
+                       help="all_maps.json or map_server yaml the default start comes from "
+                            "(default: $ROVER_WEB_MAPS_FILE, else map_files/all_maps.json)")
+    group.add_argument("--goal-topic", default="/goal_pose", help="PoseStamped goals to drive to (frame map)")
+    group.add_argument("--goal-speed", type=float, default=0.5, metavar="M_PER_S",
+                       help="top speed while driving to a goal")
+
+
+def default_start(maps_file: str | None = None) -> tuple[float, float, float]:
+    """The first waypoint (else the centre) of the first map the GUI will show."""
+    from ..map_files import first_waypoint_or_centre, load_catalog, maps_file_path
+
+    path = maps_file_path(maps_file or os.environ.get("ROVER_WEB_MAPS_FILE") or "map_files/all_maps.json")
+    first = next(iter(load_catalog(path).values()))
+    return first_waypoint_or_centre(first)
 
 
 def from_arguments(args: argparse.Namespace, context) -> RoverSim:
-    x, y, yaw = args.start if args.start else (0.0, 0.0, 0.0)
-    return RoverSim(context=context, x=x, y=y, yaw=yaw, stamped=args.stamped)
+    x, y, yaw = args.start if args.start else default_start(args.maps_file)
+    return RoverSim(context=context, x=x, y=y, yaw=yaw, stamped=args.stamped, goal_topic=args.goal_topic,
+                    goal_speed_mps=args.goal_speed)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -1,0 +1,29 @@
+"""Mission control panels: operator buttons and status displays for any robot, defined in TOML.
+
+The default file (drone.toml beside this module) is the drone's take-off / return / stop panel;
+ROVER_WEB_PANELS_FILE names another. Modules: spec (the file and its validation), state (what a
+panel shows and allows), service (ROS side and the command path), oplog (SQLite operator log),
+routes (pages and API).
+"""
+
+from __future__ import annotations
+
+from ..core import Rover
+from . import routes, spec
+from .oplog import OperatorLog
+from .service import PanelService
+
+
+def init_app(app, rover: Rover) -> None:
+    from ..ros.panel_msgs import field_kind
+
+    config = rover.config
+    specs = spec.load(config["ROVER_WEB_PANELS_FILE"], config["ROVER_WEB_STALE_AFTER_S"], field_kind)
+    rover.hub.register("panel", "panel_log")
+    service = PanelService(specs, rover, OperatorLog(rover.db, config["ROVER_WEB_PANELS_LOG_KEEP"]))
+    app.extensions["rover_web_panels"] = service
+    app.register_blueprint(routes.bp)
+    rover.add_panel(20, "panels/panels.html", "Control panels", channels=("panel",))
+    rover.add_nav("Panels", "/panels")
+    service.start()
+    rover.on_shutdown(service.stop)

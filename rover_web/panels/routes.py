@@ -1,0 +1,105 @@
+"""Pages (/panels, /panels/<panel>) and the API (/api/panels/...) of the control panels."""
+
+from __future__ import annotations
+
+from flask import Blueprint, abort, current_app, jsonify, render_template, request
+
+from ..http import ApiError, json_body
+from .service import PanelService
+
+bp = Blueprint("panels", __name__)
+
+MAX_LOG_LIMIT = 500
+
+
+def service() -> PanelService:
+    return current_app.extensions["rover_web_panels"]
+
+
+def _client() -> str:
+    return request.remote_addr or ""
+
+
+def _page_panels(panel_ids: list[str]) -> list[dict]:
+    svc = service()
+    shown = current_app.config["ROVER_WEB_PANELS_LOG_SHOWN"]
+    views = svc.views()
+    return [{"spec": svc.specs[pid], "view": views[pid], "log": svc.oplog.recent(pid, shown)} for pid in panel_ids]
+
+
+@bp.get("/panels")
+def panels_page():
+    svc = service()
+    return render_template("control_panels.html", panels=_page_panels(list(svc.specs)), single=None,
+                           log_shown=current_app.config["ROVER_WEB_PANELS_LOG_SHOWN"])
+
+
+@bp.get("/panels/<panel_id>")
+def panel_page(panel_id: str):
+    svc = service()
+    if panel_id not in svc.specs:
+        abort(404, f"no panel {panel_id[:40]!r}")
+    return render_template("control_panels.html", panels=_page_panels([panel_id]), single=svc.specs[panel_id],
+                           log_shown=current_app.config["ROVER_WEB_PANELS_LOG_SHOWN"])
+
+
+@bp.app_context_processor
+def panel_summaries():
+    """`panel_summaries()` for the dashboard card, evaluated only where a template calls it."""
+    def summaries() -> list[dict]:
+        svc = current_app.extensions.get("rover_web_panels")
+        if svc is None:
+            return []
+        views = svc.views()
+        return [{"spec": spec, "view": views[pid]} for pid, spec in svc.specs.items()]
+    return {"panel_summaries": summaries}
+
+
+@bp.get("/api/panels")
+def list_panels():
+    svc = service()
+    return jsonify(panels=[svc.detail(pid) for pid in svc.specs])
+
+
+@bp.get("/api/panels/<panel_id>")
+def get_panel(panel_id: str):
+    return jsonify(service().detail(panel_id))
+
+
+@bp.get("/api/panels/<panel_id>/log")
+def get_log(panel_id: str):
+    svc = service()
+    svc.panel(panel_id)
+    raw = request.args.get("limit", "50")
+    try:
+        limit = int(raw)
+    except ValueError:
+        limit = -1
+    if not 1 <= limit <= MAX_LOG_LIMIT:
+        raise ApiError(400, "bad_limit", f"limit must be an integer from 1 to {MAX_LOG_LIMIT}, got {raw[:20]!r}")
+    return jsonify(panel=panel_id, entries=svc.oplog.recent(panel_id, limit))
+
+
+@bp.post("/api/panels/<panel_id>/unlock")
+def unlock(panel_id: str):
+    svc = service()
+    svc.panel(panel_id)
+    json_body(required=False)  # a body, if any, must still be valid JSON
+    return jsonify(svc.unlock(panel_id, _client()))
+
+
+@bp.post("/api/panels/<panel_id>/lock")
+def lock(panel_id: str):
+    svc = service()
+    svc.panel(panel_id)
+    json_body(required=False)
+    return jsonify(svc.lock(panel_id, _client()))
+
+
+@bp.post("/api/panels/<panel_id>/<control_id>")
+def command(panel_id: str, control_id: str):
+    try:
+        body: dict | ApiError = json_body(required=False)
+    except ApiError as exc:
+        body = exc  # still 404 first for an unknown control, then logged as an invalid command
+    return jsonify(service().command(panel_id, control_id, body, _client()))
