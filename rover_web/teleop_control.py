@@ -246,7 +246,7 @@ class TeleopController:
         """POST /api/teleop stop: always wins. The holder must send a fresh input to move again."""
         with self._cond:
             self._expire(self._clock())
-            self._stop("rest_stop", bump=[self._holder] if self._holder else ())
+            self._stop("rest_stop", bump=[self._holder] if self._holder else (), always=True)
             self._changed()
 
     # --- e-stop latch ---
@@ -261,7 +261,7 @@ class TeleopController:
         with self._cond:
             if not self._estop["engaged"]:
                 self._estop = {"engaged": True, "since": self._wall(), "by": by}
-            self._stop("estop", bump=list(self._sessions.values()))
+            self._stop("estop", bump=list(self._sessions.values()), always=True)
             self._changed()
             return dict(self._estop)
 
@@ -332,11 +332,15 @@ class TeleopController:
             self._stop("deadman", bump=[command.session])
         self._changed()
 
-    def _stop(self, reason: str, bump=()) -> None:
+    def _stop(self, reason: str, bump=(), always: bool = False) -> None:
+        """End the held command with one zero. With nothing held, only an explicit stop (REST stop,
+        e-stop) publishes: an idle page closing must not send zeros that would, say, interrupt
+        an autonomous goal the robot is following."""
+        if self._command is not None or always:
+            self._publish_zero()
+            self._last_stop = {"reason": reason, "at": round(self._wall(), 3)}
         self._command = None
         self._next_tick = math.inf
-        self._publish_zero()
-        self._last_stop = {"reason": reason, "at": round(self._wall(), 3)}
         for session in bump:
             if session is not None:
                 session.epoch += 1

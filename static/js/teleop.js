@@ -85,7 +85,7 @@ function start() {
     stick = null;
     keys.clear();
     stopRepeat();
-    if (driving || inControl) send({ stop: true });
+    if (driving) send({ stop: true });
     driving = false;
   }
 

@@ -284,3 +284,23 @@ def test_repeater_thread_wakes_on_time_and_exits_on_close():
     finally:
         repeater.stop()
     assert not repeater.alive
+
+
+def test_idle_stops_publish_nothing_but_explicit_stops_always_publish_zero(rig):
+    """An idle page closing or blurring must not send zeros (they would interrupt an autonomous
+    goal); a REST stop or the e-stop is a request to stop whatever moves the robot."""
+    ctl, clock, out, _ = rig
+    a = ctl.connect()
+    ctl.drive(a, 0.5, 0)
+    ctl.stop(a)
+    n = len(out.sent)
+    ctl.stop(a)
+    ctl.release(a)
+    b = ctl.connect()
+    ctl.takeover(b)
+    ctl.disconnect(b)
+    assert len(out.sent) == n
+    ctl.rest_stop()
+    assert out.sent[n:] == [(100.0, 0.0, 0.0)]
+    ctl.engage_estop("x")
+    assert out.sent[n + 1:] == [(100.0, 0.0, 0.0)]
