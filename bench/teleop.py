@@ -20,6 +20,7 @@ import os
 import statistics
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 
@@ -234,7 +235,9 @@ def main() -> None:
     parser.add_argument("--hold-s", type=float, default=10.0)
     parser.add_argument("--no-baseline", action="store_true")
     args = parser.parse_args()
-    env = ros_env()
+    scratch = tempfile.TemporaryDirectory(prefix="rover_web-bench-teleop-")
+    # Its own database: the bench must never read or change a real e-stop latch.
+    env = ros_env(ROVER_WEB_DB_PATH=os.path.join(scratch.name, "bench.sqlite3"))
     print(f"# teleop bench on {machine()}: app in its own process, subscriber in another "
           f"(ROS domain {env['ROS_DOMAIN_ID']})", flush=True)
     server = Server(env)
@@ -257,6 +260,7 @@ def main() -> None:
         server.stop()
     if not args.no_baseline:
         bench_baseline(env, args.frames)
+    scratch.cleanup()
 
 
 if __name__ == "__main__":
