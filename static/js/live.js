@@ -82,6 +82,14 @@ function watchdog() {
   if (troubleSince && now - troubleSince > LOST_AFTER_MS) setServerState('lost');
 }
 
-if (document.readyState === 'loading') document.addEventListener('DOMContentLoaded', open);
-else queueMicrotask(open);
+// Module scripts run while readyState is already 'interactive', one after another, with a
+// microtask checkpoint between them: opening in a microtask would open before the page's later
+// modules called on(). DOMContentLoaded fires only after every deferred/module script ran.
+let opened = false;
+const openOnce = () => { if (!opened) { opened = true; open(); } };
+if (document.readyState === 'complete') queueMicrotask(openOnce);
+else {
+  document.addEventListener('DOMContentLoaded', openOnce);
+  window.addEventListener('load', openOnce);  // in case this module was loaded after DOMContentLoaded
+}
 setInterval(watchdog, 500);

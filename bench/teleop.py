@@ -1,0 +1,267 @@
+"""Teleop: WebSocket frame -> Twist on /cmd_vel in a separate rclpy process; close -> zero; rate jitter.
+
+    .venv/bin/python bench/teleop.py [--frames 2000] [--trials 100] [--hold-s 10]
+
+1. frame -> topic: `--frames` joystick frames at 40 Hz, each a new value, from a WebSocket client
+   to the app (`flask run` in its own process); latency is send time to arrival in the subscriber
+   process (both CLOCK_MONOTONIC). Server CPU and RSS over the run.
+2. close -> zero: `--trials` times, drive, then send the WebSocket close frame; time to the zero Twist.
+3. publish-rate jitter: hold one value for `--hold-s` with keep-alives every 100 ms (as the page
+   does), so the server's repeater alone sets the rate; intervals between Twists at the subscriber.
+4. baseline: the same number of Twists at 40 Hz from a plain rclpy publisher in this process to
+   the same subscriber, measured the same way (what rclpy -> rclpy costs on this machine).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+from common import ROOT, Server, machine, percentile, ros_env, summary_ms
+
+MAX_LINEAR = 5.0
+RATE_HZ = 40.0
+
+
+class Subscriber:
+    """bench/cmd_vel_subscriber.py in its own process; every Twist with its arrival time."""
+
+    def __init__(self, env: dict, topic: str = "/cmd_vel"):
+        self.proc = subprocess.Popen([sys.executable, str(ROOT / "bench" / "cmd_vel_subscriber.py"), "--topic", topic],
+                                     env=env, stdout=subprocess.PIPE, text=True, bufsize=1)
+        if self.proc.stdout.readline().strip() != "ready":
+            raise RuntimeError("subscriber did not start")
+        self.messages: list[tuple[float, float, float]] = []
+        self._cond = threading.Condition()
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self) -> None:
+        for line in self.proc.stdout:
+            t_ns, lin, ang = line.split()
+            with self._cond:
+                self.messages.append((int(t_ns) * 1e-9, float(lin), float(ang)))
+                self._cond.notify_all()
+
+    def mark(self) -> int:
+        with self._cond:
+            return len(self.messages)
+
+    def since(self, mark: int) -> list[tuple[float, float, float]]:
+        with self._cond:
+            return self.messages[mark:]
+
+    def wait_for(self, predicate, mark: int = 0, timeout: float = 5.0) -> tuple[float, float, float]:
+        deadline = time.monotonic() + timeout
+        with self._cond:
+            i = mark
+            while True:
+                while i < len(self.messages):
+                    if predicate(self.messages[i]):
+                        return self.messages[i]
+                    i += 1
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    raise TimeoutError("no matching Twist")
+                self._cond.wait(remaining)
+
+    def stop(self) -> None:
+        self.proc.terminate()
+        try:
+            self.proc.wait(5)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+
+
+def connect(url: str):
+    """A WebSocket that, like a browser, keeps reading (which answers the server's pings)."""
+    import websocket
+
+    ws = websocket.create_connection(url.replace("http://", "ws://") + "/ws/teleop?name=bench", timeout=10)
+    hello = json.loads(ws.recv())
+    assert hello["type"] == "hello"
+
+    def drain() -> None:
+        try:
+            while ws.recv_data_frame(control_frame=True)[0] != websocket.ABNF.OPCODE_CLOSE:
+                pass
+        except Exception:
+            pass
+
+    ws.settimeout(None)
+    threading.Thread(target=drain, daemon=True).start()
+    return ws
+
+
+def hang_up(ws) -> None:
+    try:
+        ws.send_close()
+    except Exception:
+        pass
+    time.sleep(0.05)
+    ws.shutdown()
+
+
+def frame(linear: float, angular: float = 0.0) -> str:
+    return json.dumps({"linear": linear, "angular": angular})
+
+
+def on_grid(n: int, rate_hz: float, send) -> list[float]:
+    """Call send(i) on a fixed 1/rate_hz grid; returns the time just before each call."""
+    period = 1.0 / rate_hz
+    start = time.monotonic() + 0.05
+    times = []
+    for i in range(n):
+        while (wait := start + i * period - time.monotonic()) > 0:
+            time.sleep(wait)
+        times.append(time.monotonic())
+        send(i)
+    return times
+
+
+def value(i: int, n: int) -> float:
+    """A distinct joystick fraction per frame, so each frame is published at once and recognisable."""
+    return round((i % n + 1) / (n + 1), 6)
+
+
+def match_latencies(sub: Subscriber, mark: int, sent: list[float], n: int, scale: float) -> list[float]:
+    first: dict[int, float] = {}
+    for t, lin, _ in sub.since(mark):
+        i = round(lin / scale * (n + 1)) - 1
+        if 0 <= i < n and i not in first:
+            first[i] = t
+    return [first[i] - sent[i] for i in range(n) if i in first]
+
+
+def bench_frames(server: Server, sub: Subscriber, n: int) -> None:
+    ws = connect(server.url)
+    mark = sub.mark()
+    cpu0, t0 = server.cpu_seconds(), time.monotonic()
+    sent = on_grid(n, RATE_HZ, lambda i: ws.send(frame(value(i, n))))
+    cpu1, t1 = server.cpu_seconds(), time.monotonic()
+    time.sleep(0.2)
+    ws.send(json.dumps({"stop": True}))
+    latencies = match_latencies(sub, mark, sent, n, MAX_LINEAR)
+    print(f"frame -> /cmd_vel at 40 Hz: {summary_ms(latencies)}  received {len(latencies)}/{n}  "
+          f"server CPU {100 * (cpu1 - cpu0) / (t1 - t0):.1f}% of one core  RSS {server.rss_mb():.0f} MB",
+          flush=True)
+    hang_up(ws)
+
+
+def bench_close(server: Server, sub: Subscriber, trials: int) -> None:
+    latencies = []
+    for k in range(trials):
+        ws = connect(server.url)
+        mark = sub.mark()
+        fraction = value(k, trials)
+        ws.send(frame(fraction))
+        sub.wait_for(lambda m: m[1] != 0.0, mark)
+        mark = sub.mark()
+        t0 = time.monotonic()
+        ws.send_close()
+        t_zero = sub.wait_for(lambda m: m[1] == 0.0 and m[2] == 0.0, mark)[0]
+        latencies.append(t_zero - t0)
+        ws.shutdown()
+        time.sleep(0.02)
+    print(f"close -> zero /cmd_vel:     {summary_ms(latencies)}", flush=True)
+
+
+def bench_rate(server: Server, sub: Subscriber, hold_s: float) -> None:
+    ws = connect(server.url)
+    mark = sub.mark()
+    on_grid(int(hold_s * 10), 10.0, lambda i: ws.send(frame(0.5)))
+    end = sub.mark()
+    ws.send(json.dumps({"stop": True}))
+    times = [t for t, lin, _ in sub.since(mark)[: end - mark] if lin == 2.5]
+    gaps = [b - a for a, b in zip(times, times[1:])]
+    period = 1.0 / RATE_HZ
+    dev_ms = [abs(g - period) * 1000 for g in gaps]
+    rate = (len(times) - 1) / (times[-1] - times[0])
+    print(f"held command, repeater at 40 Hz: {rate:.2f} Hz over {times[-1] - times[0]:.1f} s; interval "
+          f"mean {statistics.mean(gaps) * 1000:.3f} ms, stdev {statistics.pstdev(gaps) * 1000:.3f} ms, "
+          f"|dev| median {statistics.median(dev_ms):.3f} ms p99 {percentile(dev_ms, 99):.3f} ms, "
+          f"max interval {max(gaps) * 1000:.2f} ms", flush=True)
+    hang_up(ws)
+
+
+def bench_baseline(sub_env: dict, n: int) -> None:
+    """Plain rclpy publisher -> the same subscriber process, same grid, same matching."""
+    import rclpy
+    from geometry_msgs.msg import Twist
+    from rclpy.context import Context
+    from rclpy.signals import SignalHandlerOptions
+
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    context = Context()
+    rclpy.init(context=context, domain_id=int(sub_env["ROS_DOMAIN_ID"]), signal_handler_options=SignalHandlerOptions.NO)
+    node = rclpy.create_node("bench_baseline_publisher", context=context)
+    pub = node.create_publisher(Twist, "/bench_baseline", 10)
+    sub = Subscriber(sub_env, "/bench_baseline")  # ready once it sees this publisher
+    try:
+        deadline = time.monotonic() + 10
+        while pub.get_subscription_count() == 0 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        for _ in range(20):  # warm up discovery both ways
+            pub.publish(Twist())
+            time.sleep(0.02)
+        time.sleep(0.3)
+        mark = sub.mark()
+
+        def send(i: int) -> None:
+            msg = Twist()
+            msg.linear.x = value(i, n) * MAX_LINEAR
+            pub.publish(msg)
+
+        sent = on_grid(n, RATE_HZ, send)
+        time.sleep(0.3)
+        latencies = match_latencies(sub, mark, sent, n, MAX_LINEAR)
+        print(f"baseline rclpy -> rclpy:    {summary_ms(latencies)}  received {len(latencies)}/{n}", flush=True)
+    finally:
+        sub.stop()
+        node.destroy_node()
+        context.try_shutdown()
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--frames", type=int, default=2000)
+    parser.add_argument("--trials", type=int, default=100)
+    parser.add_argument("--hold-s", type=float, default=10.0)
+    parser.add_argument("--no-baseline", action="store_true")
+    args = parser.parse_args()
+    scratch = tempfile.TemporaryDirectory(prefix="rover_web-bench-teleop-")
+    # Its own database: the bench must never read or change a real e-stop latch.
+    env = ros_env(ROVER_WEB_DB_PATH=os.path.join(scratch.name, "bench.sqlite3"))
+    print(f"# teleop bench on {machine()}: app in its own process, subscriber in another "
+          f"(ROS domain {env['ROS_DOMAIN_ID']})", flush=True)
+    server = Server(env)
+    sub = None
+    try:
+        sub = Subscriber(env)
+        deadline = time.monotonic() + 10
+        import requests
+        while not sub.messages:  # discovery: publish zeros until the subscriber hears one
+            if time.monotonic() > deadline:
+                raise RuntimeError("the subscriber never heard the app")
+            requests.post(server.url + "/api/teleop", json={"command": "stop"}, timeout=5)
+            time.sleep(0.05)
+        bench_frames(server, sub, args.frames)
+        bench_close(server, sub, args.trials)
+        bench_rate(server, sub, args.hold_s)
+    finally:
+        if sub:
+            sub.stop()
+        server.stop()
+    if not args.no_baseline:
+        bench_baseline(env, args.frames)
+    scratch.cleanup()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,446 @@
+"""The teleop controller: scaling, clamps, deadman, e-stop latch, control ownership, repeater.
+
+Pure Python (no Flask, no rclpy). The output is anything with `send(linear_mps, angular_rps)` and
+`zero()` (rover.cmd_vel in the app) and the clocks are injectable, so every rule below is
+unit-tested with a fake clock and a recording output.
+
+Rules, all enforced under one lock so no two threads can interleave a stale command after a stop:
+
+- A joystick/keyboard input is published at once from the thread that received it; the held
+  command is then repeated every 1/rate_hz by one repeater thread (`Repeater`), never by browsers.
+- Deadman: a joystick/keyboard command with no fresh input for `deadman_s` is stopped (one zero
+  published, nothing more). The check also runs lazily before every input, so a server that was
+  itself stalled stops first and only then looks at the frames that piled up.
+- Epochs: every socket session has an epoch, starting at 0, that its motion frames must echo.
+  A stop the operator did not ask for (deadman, e-stop, takeover, REST stop) bumps the epoch and
+  tells the session. Frames sent before the client heard of the stop carry the old epoch and are
+  dropped, so frames queued during a stall can never restart the robot; motion resumes only on a
+  frame sent after the server's stop notice reached the client, i.e. from a live operator.
+- One operator at a time: the first session to drive holds control; others are view-only until the
+  holder releases, disconnects or another session explicitly takes over.
+- E-stop: a latch. While engaged only zero is published and every motion request is refused (409).
+- REST commands run for a bounded duration (their own deadman) and only while nobody holds control;
+  a REST `stop` always wins.
+"""
+
+from __future__ import annotations
+
+import itertools
+import logging
+import math
+import secrets
+import threading
+import time
+from collections import Counter, deque
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+log = logging.getLogger(__name__)
+
+# POST /api/teleop commands as (linear, angular) directions; +angular turns left (REP 103).
+REST_COMMANDS: dict[str, tuple[float, float]] = {
+    "forward": (1.0, 0.0), "back": (-1.0, 0.0), "left": (0.0, 1.0), "right": (0.0, -1.0),
+}
+SOURCES = ("joystick", "keyboard")
+
+
+@dataclass(frozen=True)
+class Limits:
+    max_linear_mps: float
+    max_angular_rps: float
+
+
+def fraction(value: Any) -> float:
+    """A joystick axis as a fraction in [-1, 1]; anything non-finite or not a number is 0 (stop)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return 0.0
+    value = float(value)
+    if not math.isfinite(value):
+        return 0.0
+    return max(-1.0, min(1.0, value))
+
+
+def scale(linear: Any, angular: Any, limits: Limits) -> tuple[float, float]:
+    """Joystick fractions to (m/s, rad/s): always finite and within the configured maxima."""
+    return fraction(linear) * limits.max_linear_mps, fraction(angular) * limits.max_angular_rps
+
+
+class Refused(Exception):
+    """A request the controller will not carry out; `status` is the HTTP status it maps to."""
+
+    def __init__(self, code: str, message: str, status: int = 409, **extra: Any):
+        super().__init__(message)
+        self.code, self.message, self.status, self.extra = code, message, status, extra
+
+    def as_frame(self) -> dict:
+        return {"type": "error", "error": self.code, "message": self.message, "status": self.status, **self.extra}
+
+
+@dataclass(eq=False)
+class Session:
+    """One teleop WebSocket. `outbox` holds messages for it; only its own socket thread sends them."""
+
+    id: str
+    name: str
+    epoch: int = 0
+    outbox: deque = field(default_factory=lambda: deque(maxlen=64))
+
+    def public(self) -> dict:
+        return {"id": self.id, "name": self.name}
+
+
+@dataclass
+class Command:
+    linear_mps: float
+    angular_rps: float
+    source: str                  # joystick | keyboard | rest
+    session: Session | None      # None for REST
+    expires_at: float            # deadman deadline, or the end of a REST command's duration
+
+
+class TeleopController:
+    def __init__(self, output, limits: Limits, *, rate_hz: float = 40.0, deadman_s: float = 0.3,
+                 clock: Callable[[], float] = time.monotonic, wall_clock: Callable[[], float] = time.time,
+                 on_state: Callable[[dict], None] | None = None, estop: dict | None = None):
+        self._cond = threading.Condition(threading.RLock())
+        self._output = output
+        self.limits = limits
+        self.rate_hz = rate_hz
+        self.period_s = 1.0 / rate_hz
+        self.deadman_s = deadman_s
+        self._clock = clock
+        self._wall = wall_clock
+        self._on_state = on_state
+        self._sessions: dict[str, Session] = {}
+        self._holder: Session | None = None
+        self._command: Command | None = None
+        self._next_tick = math.inf
+        self._estop = {"engaged": False, "since": None, "by": None}
+        if estop:
+            self._estop.update({k: estop[k] for k in ("engaged", "since", "by") if k in estop})
+        self._last_stop: dict | None = None
+        self._closed = False
+        self._shown: dict | None = None
+        self._numbers = itertools.count(1)
+        self.stats: Counter = Counter()
+
+    # --- sessions and control ---
+
+    def connect(self, name: str | None = None) -> Session:
+        with self._cond:
+            number = next(self._numbers)
+            session = Session(id=f"{number}-{secrets.token_hex(3)}", name=name or f"operator {number}")
+            self._sessions[session.id] = session
+            self._changed()
+            return session
+
+    def disconnect(self, session: Session) -> None:
+        """The socket closed or failed: if it held control, zero at once and free control."""
+        with self._cond:
+            self._expire(self._clock())
+            if self._sessions.pop(session.id, None) is None:
+                return
+            if self._holder is session:
+                self._holder = None
+                self._stop("disconnected")
+            self._changed()
+
+    def takeover(self, session: Session) -> None:
+        """Explicitly take control (or claim it when free). Whatever was moving stops first."""
+        with self._cond:
+            self._expire(self._clock())
+            self._require_open(session)
+            if self._holder is session:
+                return
+            previous = self._holder
+            self._holder = session
+            if self._command is not None:
+                self._stop("taken_over")
+            if previous is not None:
+                previous.epoch += 1  # frames it still had in flight are stale
+                self._tell(previous, "taken_over")
+            self._tell(session, "in_control")
+            self._changed()
+
+    def release(self, session: Session) -> None:
+        """The holder gives control back; the robot stops."""
+        with self._cond:
+            self._expire(self._clock())
+            if self._holder is not session:
+                return
+            self._holder = None
+            self._stop("released")
+            self._tell(session, "released")
+            self._changed()
+
+    # --- motion ---
+
+    def drive(self, session: Session, linear: float, angular: float, *, epoch: int = 0,
+              source: str = "joystick") -> tuple[float, float]:
+        """A joystick/keyboard input (fractions of the maxima). Published at once if it changed."""
+        with self._cond:
+            now = self._clock()
+            self._expire(now)  # a stalled server stops first, then judges the frames that piled up
+            self._require_open(session)
+            if self._estop["engaged"]:
+                raise Refused("estop_engaged", "the e-stop is engaged: release it (POST /api/estop "
+                              '{"engaged": false}) before driving')
+            if epoch != session.epoch:
+                self.stats["stale_dropped"] += 1
+                raise Refused("stale_epoch", f"frame for epoch {epoch} dropped: the robot was stopped "
+                              f"({self._last_stop_reason()}); send epoch {session.epoch} to drive again",
+                              epoch=session.epoch)
+            if self._holder is None:
+                self._holder = session
+                self._tell(session, "in_control")
+            elif self._holder is not session:
+                raise Refused("not_in_control", f"{self._holder.name} holds control; you are view-only "
+                              'until they release it or you send {"takeover": true}',
+                              holder=self._holder.public())
+            linear_mps, angular_rps = scale(linear, angular, self.limits)
+            previous = self._command
+            self._command = Command(linear_mps, angular_rps, source, session, now + self.deadman_s)
+            if (previous is None or previous.session is not session
+                    or (previous.linear_mps, previous.angular_rps) != (linear_mps, angular_rps)):
+                self._publish(linear_mps, angular_rps)
+                self._next_tick = now + self.period_s
+            self.stats["inputs"] += 1
+            self._changed()
+            self._cond.notify_all()
+            return linear_mps, angular_rps
+
+    def stop(self, session: Session, reason: str = "operator") -> bool:
+        """The holder's own stop (stick released, key up, tab hidden). A viewer's stop is ignored."""
+        with self._cond:
+            self._expire(self._clock())
+            if self._holder is not None and self._holder is not session:
+                return False
+            self._stop(reason)
+            self._changed()
+            return True
+
+    def rest_command(self, command: str, speed: float, duration_s: float) -> tuple[float, float]:
+        """POST /api/teleop: drive for `duration_s`, then stop by itself."""
+        with self._cond:
+            now = self._clock()
+            self._expire(now)
+            if self._closed:
+                raise Refused("shutting_down", "the server is shutting down", status=503)
+            if self._estop["engaged"]:
+                raise Refused("estop_engaged", "the e-stop is engaged: release it (POST /api/estop "
+                              '{"engaged": false}) before driving')
+            if self._holder is not None:
+                raise Refused("not_in_control", f"{self._holder.name} holds control with the joystick; "
+                              "REST commands run only while nobody holds it (stop always works)",
+                              holder=self._holder.public())
+            direction = REST_COMMANDS[command]
+            linear_mps, angular_rps = scale(direction[0] * speed, direction[1] * speed, self.limits)
+            self._command = Command(linear_mps, angular_rps, "rest", None, now + duration_s)
+            self._publish(linear_mps, angular_rps)
+            self._next_tick = now + self.period_s
+            self._changed()
+            self._cond.notify_all()
+            return linear_mps, angular_rps
+
+    def rest_stop(self) -> None:
+        """POST /api/teleop stop: always wins. The holder must send a fresh input to move again."""
+        with self._cond:
+            self._expire(self._clock())
+            self._stop("rest_stop", bump=[self._holder] if self._holder else (), always=True)
+            self._changed()
+
+    # --- e-stop latch ---
+
+    @property
+    def estop(self) -> dict:
+        with self._cond:
+            return dict(self._estop)
+
+    def engage_estop(self, by: str) -> dict:
+        """Zero at once and refuse motion until released. Works whoever holds control."""
+        with self._cond:
+            if not self._estop["engaged"]:
+                self._estop = {"engaged": True, "since": self._wall(), "by": by}
+            self._stop("estop", bump=list(self._sessions.values()), always=True)
+            self._changed()
+            return dict(self._estop)
+
+    def release_estop(self, by: str) -> dict:
+        with self._cond:
+            if self._estop["engaged"]:
+                self._estop = {"engaged": False, "since": self._wall(), "by": by}
+                for session in self._sessions.values():
+                    self._tell(session, "estop_released")
+                self._changed()
+            return dict(self._estop)
+
+    # --- the repeater's side ---
+
+    def tick(self) -> float | None:
+        """Enforce deadlines and repeat the held command when due; the next wake-up time or None."""
+        with self._cond:
+            now = self._clock()
+            self._expire(now)
+            command = self._command
+            if command is None:
+                return None
+            if now >= self._next_tick:
+                self._publish(command.linear_mps, command.angular_rps)
+                self.stats["repeated"] += 1
+                self._next_tick += self.period_s  # a fixed grid: late wake-ups do not lower the rate
+                if self._next_tick <= now:
+                    self._next_tick = now + self.period_s
+            return min(self._next_tick, command.expires_at)
+
+    def close(self) -> None:
+        """Shutdown: nothing is published after this, and the repeater exits."""
+        with self._cond:
+            self._command = None
+            self._closed = True
+            self._cond.notify_all()
+
+    @property
+    def closed(self) -> bool:
+        return self._closed
+
+    # --- state for pages ---
+
+    def state(self) -> dict:
+        with self._cond:
+            return self._state()
+
+    def session_state(self, session: Session, reason: str = "") -> dict:
+        with self._cond:
+            return self._session_message(session, reason)
+
+    # --- internals (called with the lock held) ---
+
+    def _require_open(self, session: Session) -> None:
+        if self._closed:
+            raise Refused("shutting_down", "the server is shutting down", status=503)
+        if session.id not in self._sessions:
+            raise Refused("disconnected", "this session is closed; reconnect", status=410)
+
+    def _expire(self, now: float) -> None:
+        command = self._command
+        if command is None or now < command.expires_at:
+            return
+        if command.session is None:
+            self._stop("duration_elapsed")
+        else:
+            self.stats["deadman_stops"] += 1
+            self._stop("deadman", bump=[command.session])
+        self._changed()
+
+    def _stop(self, reason: str, bump=(), always: bool = False) -> None:
+        """End the held command with one zero. With nothing held, only an explicit stop (REST stop,
+        e-stop) publishes: an idle page closing must not send zeros that would, say, interrupt
+        an autonomous goal the robot is following."""
+        if self._command is not None or always:
+            self._publish_zero()
+            self._last_stop = {"reason": reason, "at": round(self._wall(), 3)}
+        self._command = None
+        self._next_tick = math.inf
+        for session in bump:
+            if session is not None:
+                session.epoch += 1
+                self._tell(session, reason)
+        self._cond.notify_all()
+
+    def _tell(self, session: Session, reason: str) -> None:
+        session.outbox.append(self._session_message(session, reason))
+
+    def _session_message(self, session: Session, reason: str) -> dict:
+        holder = self._holder
+        return {"type": "state", "epoch": session.epoch, "in_control": holder is session,
+                "holder": holder.public() if holder else None, "estop": self._estop["engaged"],
+                "reason": reason}
+
+    def _publish(self, linear_mps: float, angular_rps: float) -> None:
+        if self._closed:
+            return
+        try:
+            self._output.send(linear_mps, angular_rps)
+            self.stats["published"] += 1
+        except Exception:  # never let a publisher error kill the deadman
+            self.stats["publish_errors"] += 1
+            log.exception("could not publish the teleop command")
+
+    def _publish_zero(self) -> None:
+        if self._closed:
+            return
+        try:
+            self._output.zero()
+            self.stats["zeros"] += 1
+        except Exception:
+            self.stats["publish_errors"] += 1
+            log.exception("could not publish the teleop stop")
+
+    def _last_stop_reason(self) -> str:
+        return self._last_stop["reason"] if self._last_stop else "stopped"
+
+    def _state(self) -> dict:
+        command, holder = self._command, self._holder
+        return {
+            "linear_mps": round(command.linear_mps, 4) if command else 0.0,
+            "angular_rps": round(command.angular_rps, 4) if command else 0.0,
+            "moving": bool(command and (command.linear_mps or command.angular_rps)),
+            "source": command.source if command else None,
+            "holder": holder.public() if holder else None,
+            "operators": len(self._sessions),
+            "estop": dict(self._estop),
+            "last_stop": dict(self._last_stop) if self._last_stop else None,
+            "max_linear_mps": self.limits.max_linear_mps,
+            "max_angular_rps": self.limits.max_angular_rps,
+            "rate_hz": self.rate_hz,
+            "deadman_s": self.deadman_s,
+        }
+
+    def _changed(self) -> None:
+        if self._on_state is None:
+            return
+        state = self._state()
+        if state != self._shown:
+            self._shown = state
+            try:
+                self._on_state(state)
+            except Exception:
+                log.exception("teleop state listener failed")
+
+
+class Repeater:
+    """The one thread that repeats the held command and enforces deadlines, waking exactly when due.
+
+    It sleeps on the controller's condition until the next tick or deadline, whichever is first;
+    every input notifies it so it re-plans at once. Idle (nothing held), it waits without a timeout.
+    """
+
+    def __init__(self, controller: TeleopController):
+        self.controller = controller
+        self._thread = threading.Thread(target=self._run, name="teleop-repeater", daemon=True)
+
+    def start(self) -> "Repeater":
+        self._thread.start()
+        return self
+
+    def _run(self) -> None:
+        c = self.controller
+        with c._cond:
+            while not c._closed:
+                try:
+                    wake_at = c.tick()
+                except Exception:  # pragma: no cover - a bug; keep enforcing the deadman anyway
+                    log.exception("teleop repeater tick failed")
+                    wake_at = c._clock() + c.period_s
+                timeout = None if wake_at is None else max(0.0, wake_at - c._clock())
+                if timeout is None or timeout > 0:
+                    c._cond.wait(timeout)
+
+    def stop(self, timeout_s: float = 2.0) -> None:
+        self.controller.close()
+        if self._thread.is_alive():
+            self._thread.join(timeout_s)
+
+    @property
+    def alive(self) -> bool:
+        return self._thread.is_alive()

@@ -1,0 +1,227 @@
+// The Drive panel: virtual joystick (nipplejs) and keyboard over the /ws/teleop WebSocket.
+//
+// The server decides when the robot stops: it repeats the held command at its own rate and stops
+// it when this page falls silent for its deadman time. The page only says what the operator holds,
+// repeating it every keepalive_s while held, and says stop on release, Space, a hidden tab,
+// pagehide and blur. After a stop it did not ask for (deadman, e-stop, takeover), the server sends
+// a new epoch; frames carrying the old one are dropped, so only input sent after that notice moves
+// the robot again.
+import { on } from './live.js';
+import { operatorName, setOperatorName } from './operator.js';
+
+const card = document.getElementById('teleop-card');
+if (card) start();
+
+function start() {
+  const $ = (id) => document.getElementById(id);
+  const KEYS = {
+    KeyW: 'up', ArrowUp: 'up', KeyS: 'down', ArrowDown: 'down',
+    KeyA: 'left', ArrowLeft: 'left', KeyD: 'right', ArrowRight: 'right',
+  };
+
+  let ws = null;
+  let session = null;
+  let epoch = 0;
+  let inControl = false;
+  let holder = null;
+  let estop = card.dataset.mode === 'estop';
+  let keepaliveMs = 100;
+  let retryMs = 500;
+  let stick = null;            // {linear, angular} while the joystick is held
+  let stickSuppressed = false; // after a stop by blur/hide/Space the stick must be pressed again
+  const keys = new Set();
+  let keySpeed = 0.5;
+  let repeatTimer = null;
+  let driving = false;         // a drive frame went out since the last stop
+
+  const clamp = (v) => (Number.isFinite(v) ? Math.max(-1, Math.min(1, v)) : 0);
+  const round = (v) => Math.round(clamp(v) * 1000) / 1000;
+  const text = (id, value) => { const el = $(id); if (el) el.textContent = value; };
+
+  function message(msg) { text('teleop-message', msg); }
+
+  function send(obj) {
+    if (ws && ws.readyState === WebSocket.OPEN) ws.send(JSON.stringify(obj));
+  }
+
+  function wanted() {
+    if (stick) return { linear: stick.linear, angular: stick.angular, source: 'joystick' };
+    if (keys.size) {
+      const axis = (a, b) => (keys.has(a) ? 1 : 0) - (keys.has(b) ? 1 : 0);
+      return { linear: keySpeed * axis('up', 'down'), angular: keySpeed * axis('left', 'right'), source: 'keyboard' };
+    }
+    return null;
+  }
+
+  const mayDrive = () => !estop && (inControl || holder === null);
+
+  function sendDrive() {
+    const cmd = wanted();
+    if (!cmd || !mayDrive()) return;
+    send({ linear: round(cmd.linear), angular: round(cmd.angular), epoch, source: cmd.source });
+    driving = true;
+  }
+
+  function stopRepeat() {
+    clearInterval(repeatTimer);
+    repeatTimer = null;
+  }
+
+  // Called whenever what the operator holds changes.
+  function update() {
+    if (!wanted()) {
+      stopRepeat();
+      if (driving) send({ stop: true });
+      driving = false;
+      return;
+    }
+    sendDrive();
+    if (!repeatTimer) repeatTimer = setInterval(sendDrive, keepaliveMs);
+  }
+
+  // Blur, hidden tab, pagehide, Space: forget everything held and tell the server at once.
+  function stopAll() {
+    if (stick) stickSuppressed = true;
+    stick = null;
+    keys.clear();
+    stopRepeat();
+    if (driving) send({ stop: true });
+    driving = false;
+  }
+
+  function render() {
+    const mode = estop ? 'estop' : inControl ? 'driving' : holder ? 'view-only' : 'free';
+    card.dataset.mode = mode;
+    text('teleop-holder', inControl ? `you (${holder ? holder.name : operatorName()})`
+      : holder ? `${holder.name} (view only)` : 'free');
+    $('teleop-takeover').hidden = !(holder && !inControl) || !session;
+    $('teleop-release').hidden = !inControl;
+    if (estop) message('E-stop engaged: release it to drive.');
+    else if (mode === 'view-only') message(`${holder.name} is driving. Take control to drive.`);
+  }
+
+  function onServerMessage(m) {
+    if (m.type === 'hello') {
+      session = m.session;
+      keepaliveMs = Math.max(20, 1000 * m.keepalive_s);
+      retryMs = 500;
+      const link = $('teleop-link');
+      link.dataset.state = 'live';
+      link.textContent = `connected as ${m.name}`;
+    }
+    if (m.type === 'hello' || m.type === 'state') {
+      epoch = m.epoch;
+      inControl = m.in_control;
+      holder = m.holder;
+      estop = m.estop;
+      if (m.reason === 'deadman') message('Stopped: no input reached the server in time.');
+      else if (m.reason === 'taken_over' && !inControl) message('Another operator took control.');
+      else if (m.reason === 'in_control' || m.reason === 'estop_released') message('');
+      render();
+      if (wanted()) sendDrive();  // still held: the new epoch makes this a fresh, live input
+    } else if (m.type === 'error' && m.error !== 'stale_epoch') {
+      message(m.message);
+    }
+  }
+
+  function connect() {
+    const scheme = location.protocol === 'https:' ? 'wss:' : 'ws:';
+    ws = new WebSocket(`${scheme}//${location.host}/ws/teleop?name=${encodeURIComponent(operatorName())}`);
+    ws.onmessage = (ev) => {
+      let m;
+      try { m = JSON.parse(ev.data); } catch { return; }
+      onServerMessage(m);
+    };
+    ws.onclose = () => {
+      session = null;
+      inControl = false;
+      driving = false;
+      const link = $('teleop-link');
+      link.dataset.state = 'reconnecting';
+      link.textContent = 'reconnecting';
+      render();
+      setTimeout(connect, retryMs);
+      retryMs = Math.min(retryMs * 2, 5000);
+    };
+  }
+
+  // --- inputs ---
+
+  const joystick = window.nipplejs.create({
+    zone: $('teleop-joystick'), mode: 'static', position: { left: '50%', top: '50%' },
+    color: '#58a6ff', size: 150, restOpacity: 0.7,
+  });
+  joystick.on('start', () => {
+    stickSuppressed = false;
+    stick = { linear: 0, angular: 0 };
+    update();
+  });
+  joystick.on('move', (_evt, data) => {
+    if (stickSuppressed) return;
+    // vector is the knob offset over the radius: +y is up (forward), +x is right (turn right, -z).
+    stick = { linear: clamp(data.vector.y), angular: clamp(-data.vector.x) };
+    update();
+  });
+  joystick.on('end', () => {
+    stickSuppressed = false;
+    stick = null;
+    update();
+  });
+
+  const typing = (el) => el && el.closest && el.closest('input, textarea, select, [contenteditable="true"]');
+  window.addEventListener('keydown', (e) => {
+    if (e.ctrlKey || e.metaKey || e.altKey) return;
+    if (e.code === 'Space') {
+      if (typing(e.target) && e.target.type !== 'range') return;
+      e.preventDefault();
+      stopAll();
+      return;
+    }
+    const dir = KEYS[e.code];
+    if (!dir || typing(e.target)) return;
+    e.preventDefault();
+    if (!keys.has(dir)) {
+      keys.add(dir);
+      update();
+    }
+  });
+  window.addEventListener('keyup', (e) => {
+    const dir = KEYS[e.code];
+    if (dir && keys.delete(dir)) update();
+  });
+  document.addEventListener('visibilitychange', () => {
+    if (document.visibilityState === 'hidden') stopAll();
+  });
+  window.addEventListener('pagehide', stopAll);
+  window.addEventListener('blur', stopAll);
+
+  $('teleop-takeover').addEventListener('click', () => send({ takeover: true }));
+  $('teleop-release').addEventListener('click', () => { stopAll(); send({ release: true }); });
+  const speed = $('teleop-key-speed');
+  speed.addEventListener('input', () => {
+    keySpeed = Number(speed.value) / 100;
+    text('teleop-key-speed-out', `${speed.value}%`);
+  });
+  const name = $('teleop-name');
+  name.value = operatorName();
+  name.addEventListener('change', () => {
+    name.value = setOperatorName(name.value);
+    if (ws) ws.close();  // reconnect under the new name
+  });
+
+  // --- what everyone sees ---
+
+  on('teleop', (s) => {
+    text('teleop-linear', s.linear_mps.toFixed(2));
+    text('teleop-angular', s.angular_rps.toFixed(2));
+    text('teleop-source', s.source || '');
+    text('teleop-last-stop', s.last_stop ? s.last_stop.reason.replaceAll('_', ' ') : '—');
+    // Who holds control, for display and for claiming a free robot. Whether *this* socket holds it
+    // comes from the socket itself: an SSE update can be a little older than the socket's news.
+    if (!inControl) holder = s.holder;
+    estop = s.estop.engaged;
+    render();
+  });
+
+  connect();
+}

@@ -1,0 +1,252 @@
+"""The Drive panel and the e-stop in a real Chromium, with a separate ROS subscriber on /cmd_vel.
+
+The server's deadman is set to 5 s here, so every zero that arrives well within a second of
+releasing the stick, hiding the tab, blurring the window or leaving the page was sent by the page
+itself (or, leaving the page, by its socket closing), not by the server timing out.
+"""
+
+import time
+
+import pytest
+
+from tests.teleop_support import is_zero, subscribe_cmd_vel, twists, warm_up
+
+pytestmark = pytest.mark.browser
+
+DEADMAN_S = 5.0
+
+
+@pytest.fixture
+def rig(live_server_factory, ros_peer):
+    server = live_server_factory(ROVER_WEB_TELEOP_DEADMAN_S=DEADMAN_S)
+    peer = ros_peer()
+    subscribe_cmd_vel(peer)
+    warm_up(peer, server.url)
+    return server, peer
+
+
+def open_dashboard(page, server):
+    page.goto(server.url + "/")
+    page.wait_for_selector("#teleop-link[data-state='live']", timeout=10000)
+    page.wait_for_selector("#link-server[data-state='live']", timeout=10000)
+
+
+def stick_center(page):
+    box = page.locator("#teleop-joystick").bounding_box()
+    return box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+
+
+def press_stick(page, dx=0.0, dy=-60.0):
+    x, y = stick_center(page)
+    page.mouse.move(x, y)
+    page.mouse.down()
+    page.mouse.move(x + dx, y + dy, steps=6)
+
+
+def wait_moving(peer, predicate=lambda m: m["linear"]["x"] > 0, timeout=5.0):
+    return peer.wait_for("/cmd_vel", predicate, timeout=timeout)
+
+
+def assert_stops_soon(peer, t_action, what):
+    zero = peer.wait_for("/cmd_vel", lambda m: is_zero(m), timeout=2.0)
+    assert zero["t"] - t_action < 1.0, f"{what}: zero only after {zero['t'] - t_action:.3f} s"
+    time.sleep(0.4)
+    assert all(lin == 0.0 and ang == 0.0 for t, lin, ang in twists(peer) if t >= zero["t"]), what
+    return zero
+
+
+def test_joystick_drives_release_hide_blur_and_leaving_stop(rig, page, sim_process):
+    server, peer = rig
+    sim_process()  # the simulator rover, so the dashboard's Robot panel shows it moving
+    open_dashboard(page, server)
+
+    # Drag up: a separate ROS process sees positive linear x; the simulated rover moves.
+    press_stick(page)
+    wait_moving(peer)
+    # 60 of 75 px up: 0.8 of 5 m/s once the drag ends.
+    wait_moving(peer, lambda m: m["linear"]["x"] == pytest.approx(4.0, abs=0.1) and m["angular"]["z"] == 0)
+    page.wait_for_function("Number(document.getElementById('odom-linear').textContent) > 1", timeout=10000)
+    page.wait_for_function("Number(document.getElementById('teleop-linear').textContent) > 3", timeout=5000)
+    assert "you" in page.locator("#teleop-holder").inner_text()
+
+    # Release: zero.
+    peer.clear("/cmd_vel")
+    t = time.monotonic()
+    page.mouse.up()
+    assert_stops_soon(peer, t, "release")
+    page.wait_for_function("Number(document.getElementById('odom-linear').textContent) === 0", timeout=10000)
+
+    # Hidden tab (visibilitychange to hidden) while the stick is still held: zero.
+    peer.clear("/cmd_vel")
+    press_stick(page, dx=30)
+    wait_moving(peer, lambda m: m["linear"]["x"] > 0 and m["angular"]["z"] < 0)
+    peer.clear("/cmd_vel")
+    t = time.monotonic()
+    page.evaluate("""() => {
+        Object.defineProperty(document, 'visibilityState', {value: 'hidden', configurable: true});
+        Object.defineProperty(document, 'hidden', {value: true, configurable: true});
+        document.dispatchEvent(new Event('visibilitychange'));
+    }""")
+    zero = assert_stops_soon(peer, t, "hidden")
+    page.evaluate("""() => {
+        delete document.visibilityState; delete document.hidden;
+        document.dispatchEvent(new Event('visibilitychange'));
+    }""")
+    page.mouse.move(*stick_center(page), steps=2)  # still held, but the page waits for a new press
+    time.sleep(0.3)
+    assert all(lin == 0.0 for t, lin, _ in twists(peer) if t >= zero["t"])
+    page.mouse.up()
+
+    # Window blur, for real: another tab comes to the front (focus emulation off).
+    cdp = page.context.new_cdp_session(page)
+    cdp.send("Emulation.setFocusEmulationEnabled", {"enabled": False})
+    page.bring_to_front()
+    peer.clear("/cmd_vel")
+    press_stick(page)
+    wait_moving(peer)
+    peer.clear("/cmd_vel")
+    t = time.monotonic()
+    other = page.context.new_page()
+    other.bring_to_front()
+    assert_stops_soon(peer, t, "blur")
+    other.close()
+    page.bring_to_front()
+    page.mouse.up()
+
+    # Leaving the page (pagehide) while driving: zero.
+    peer.clear("/cmd_vel")
+    press_stick(page)
+    wait_moving(peer)
+    peer.clear("/cmd_vel")
+    t = time.monotonic()
+    page.goto(server.url + "/api/status")
+    assert_stops_soon(peer, t, "pagehide")
+    assert page.watch.offhost == []
+    assert page.watch.console_errors == []
+
+
+def test_keyboard_drives_while_held_and_space_stops(rig, page):
+    server, peer = rig
+    open_dashboard(page, server)
+    page.locator("#teleop-card h2").click()  # focus on the page, not in a text field
+
+    page.keyboard.down("w")
+    wait_moving(peer, lambda m: m["linear"]["x"] == 2.5)  # keys drive at 50% by default
+    time.sleep(0.5)  # held: the page keeps it alive, the server repeats it
+    assert twists(peer)[-1][1] == 2.5
+    peer.clear("/cmd_vel")
+    t = time.monotonic()
+    page.keyboard.up("w")
+    assert_stops_soon(peer, t, "key up")
+
+    peer.clear("/cmd_vel")
+    page.keyboard.down("ArrowLeft")
+    page.keyboard.down("ArrowUp")
+    wait_moving(peer, lambda m: m["linear"]["x"] == 2.5 and m["angular"]["z"] == 1.0)
+    peer.clear("/cmd_vel")
+    t = time.monotonic()
+    page.keyboard.press("Space")  # stops while the arrows are still down
+    assert_stops_soon(peer, t, "space")
+    page.keyboard.up("ArrowLeft")
+    page.keyboard.up("ArrowUp")
+    assert page.watch.console_errors == []
+
+
+def test_estop_button_latches_across_reload_and_releases(rig, page):
+    server, peer = rig
+    open_dashboard(page, server)
+    press_stick(page)
+    wait_moving(peer)
+    peer.clear("/cmd_vel")
+    t = time.monotonic()
+    page.locator("#estop-engage").click()
+    zero = assert_stops_soon(peer, t, "e-stop")
+    page.wait_for_selector("#estop[data-engaged='yes']")
+    page.mouse.up()
+
+    page.reload()
+    open_dashboard(page, server)
+    assert page.locator("#estop").get_attribute("data-engaged") == "yes"
+    assert page.locator("#estop-engage").inner_text() == "E-STOP ENGAGED"
+    assert page.locator("#teleop-card").get_attribute("data-mode") == "estop"
+    press_stick(page)
+    time.sleep(0.5)
+    page.mouse.up()
+    assert all(lin == 0.0 for t, lin, _ in twists(peer) if t >= zero["t"])
+
+    page.locator("#estop-release").click()
+    page.wait_for_selector("#estop[data-engaged='no']")
+    assert page.locator("#estop-release").is_hidden()
+    press_stick(page)
+    wait_moving(peer)
+    page.mouse.up()
+    assert page.watch.console_errors == []
+
+
+def test_estop_is_on_every_page_and_follows_other_browsers(app_factory, page):
+    """A plain page that extends base.html and asks for no teleop channel still shows the latch."""
+    import requests
+    from flask import render_template_string
+
+    from tests.conftest import LiveServer
+
+    app = app_factory()
+    app.add_url_rule("/plain", "plain", lambda: render_template_string(
+        '{% extends "base.html" %}{% block content %}<p id="plain">another page</p>{% endblock %}'))
+    server = LiveServer(app)
+    try:
+        page.goto(server.url + "/plain")
+        page.wait_for_selector("#link-server[data-state='live']", timeout=10000)
+        assert page.locator("body").get_attribute("data-channels") == "status"
+        assert page.locator("#estop[data-engaged='no'] #estop-engage").is_visible()
+        requests.post(server.url + "/api/estop", json={"engaged": True, "by": "curl"}, timeout=5)
+        page.wait_for_selector("#estop[data-engaged='yes']", timeout=5000)  # live, over SSE
+        page.reload()
+        assert page.locator("#estop").get_attribute("data-engaged") == "yes"  # rendered latched
+        page.locator("#estop-release").click()
+        page.wait_for_selector("#estop[data-engaged='no']", timeout=5000)
+        assert requests.get(server.url + "/api/estop", timeout=5).json()["engaged"] is False
+        page.locator("#estop-engage").click()
+        page.wait_for_selector("#estop[data-engaged='yes']", timeout=5000)
+        assert requests.get(server.url + "/api/estop", timeout=5).json()["by"].startswith("browser-")
+        assert page.watch.console_errors == []
+    finally:
+        server.stop()
+
+
+def test_second_browser_is_view_only_and_can_take_over(rig, browser):
+    server, peer = rig
+    ctx_a, ctx_b = browser.new_context(), browser.new_context()
+    try:
+        a, b = ctx_a.new_page(), ctx_b.new_page()
+        for p, name in ((a, "alice"), (b, "bob")):
+            p.add_init_script(f"localStorage.setItem('rover_web.operator', '{name}')")
+            open_dashboard(p, server)
+        press_stick(a)
+        wait_moving(peer)
+        b.wait_for_function("document.getElementById('teleop-holder').textContent.includes('alice (view only)')",
+                            timeout=5000)
+        assert b.locator("#teleop-card").get_attribute("data-mode") == "view-only"
+        assert b.locator("#teleop-takeover").is_visible()
+        # Bob's stick does nothing while alice holds control.
+        x, y = stick_center(b)
+        b.mouse.move(x, y)
+        b.mouse.down()
+        b.mouse.move(x, y + 60, steps=4)
+        time.sleep(0.4)
+        b.mouse.up()
+        assert all(lin >= 0 for _, lin, _ in twists(peer))
+
+        b.locator("#teleop-takeover").click()
+        peer.wait_for("/cmd_vel", is_zero, timeout=2.0)
+        b.wait_for_function("document.getElementById('teleop-holder').textContent.startsWith('you')", timeout=5000)
+        a.wait_for_function("document.getElementById('teleop-holder').textContent.includes('bob (view only)')",
+                            timeout=5000)
+        a.mouse.up()
+        peer.clear("/cmd_vel")
+        press_stick(b, dy=60)  # backwards
+        wait_moving(peer, lambda m: m["linear"]["x"] < 0)
+        b.mouse.up()
+    finally:
+        ctx_a.close()
+        ctx_b.close()
