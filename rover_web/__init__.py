@@ -22,7 +22,12 @@ from .events import EventHub
 ROOT = Path(__file__).resolve().parent.parent
 
 # Feature modules, each with init_app(app, rover): routes, subscriptions, channels, panels.
-FEATURES = ("telemetry", "teleop", "panels", "livemap", "camera", "topics")
+FEATURES = ("telemetry", "teleop", "waypoints", "panels", "livemap", "camera", "topics")
+
+# Modules with init_cli(app): `flask --app rover_web <command>` commands. They are registered
+# before (and without) the ROS node, so a command such as `flask tiles fetch` never joins the ROS
+# graph or publishes a stop on exit.
+CLI_MODULES = ("tiles",)
 
 log = logging.getLogger(__name__)
 
@@ -47,6 +52,22 @@ def _is_reloader_watcher() -> bool:
         return False
     reload = ctx.params.get("reload")
     return bool(get_debug_flag() if reload is None else reload)
+
+
+def _is_cli_command_lookup() -> bool:
+    """True when the flask CLI loads the app only to find one of its own commands (or list them).
+
+    For an app-provided command (`flask tiles fetch`, `flask --help`) Flask's FlaskGroup loads the
+    app while resolving the command name, so the current click context is the group itself; for
+    `flask run` (and `routes`, `shell`) the context is that command's.
+    """
+    try:
+        import click
+        from flask.cli import FlaskGroup
+    except ImportError:  # pragma: no cover
+        return False
+    ctx = click.get_current_context(silent=True)
+    return ctx is not None and isinstance(ctx.command, FlaskGroup)
 
 
 def create_app(test_config: Mapping[str, Any] | None = None) -> Flask:
@@ -77,9 +98,13 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     from . import http, pages, sse, status
 
     http.init_app(app)
+    for name in CLI_MODULES:
+        importlib.import_module(f"{__name__}.{name}").init_cli(app)
     if _is_reloader_watcher():
         log.warning("reloader watcher process: the ROS node starts in the serving child only")
         return app
+    if _is_cli_command_lookup():
+        return app  # a CLI command, not a server: no node, no database, no stop-on-exit hooks
 
     from .ros import require_rclpy
     require_rclpy()

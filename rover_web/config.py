@@ -85,6 +85,21 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("TELEOP_REST_DEFAULT_DURATION_S", 0.5, "float",
             "how long POST /api/teleop drives without `duration_s` before it stops by itself", 0.01, 60),
     Setting("TELEOP_REST_MAX_DURATION_S", 5.0, "float", "longest `duration_s` POST /api/teleop accepts", 0.01, 60),
+    # --- waypoints ---
+    Setting("WAYPOINTS_TOPIC", "/waypoints", "topic",
+            "std_msgs/Float64MultiArray [lng, lat] published for every waypoint added (the RobotX GUI's topic)"),
+    Setting("MISSION_TOPIC", "/mission", "topic",
+            "std_msgs/Float64MultiArray (n x 2, lng then lat) the whole ordered mission goes to on \"send mission\""),
+    Setting("FIX_TOPIC", "/fix", "topic", "sensor_msgs/NavSatFix shown as the robot's marker and track on the map"),
+    Setting("MAX_WAYPOINTS", 500, "int", "most waypoints a mission may hold (409 beyond)", 1, 100000),
+    Setting("FIX_TRACK_POINTS", 500, "int", "GPS track points kept and drawn behind the robot (oldest dropped)", 2, 20000),
+    Setting("MAP_PLACE_NAME", "Nathan Benderson Park, FL", "str", "name of the place the map opens on"),
+    Setting("MAP_CENTER_LNG", -82.4500873, "float", "longitude the map opens on (degrees east)", -180, 180),
+    Setting("MAP_CENTER_LAT", 27.3742443, "float", "latitude the map opens on (degrees north)", -85, 85),
+    Setting("MAP_ZOOM", 14.0, "float", "zoom level the map opens at", 0, 22),
+    Setting("MAP_TILES", "map_files/tiles", "optional_str",
+            "offline basemap: a z/x/y tile folder or an .mbtiles file (relative paths from the repository root); "
+            "unset or missing means no basemap"),
     # --- panels ---
     Setting("PANELS_FILE", None, "optional_str",
             "TOML file defining the mission control panels; unset means the drone panel in rover_web/panels/drone.toml"),

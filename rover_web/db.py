@@ -9,6 +9,7 @@ from __future__ import annotations
 import os
 import sqlite3
 import threading
+import weakref
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
@@ -23,38 +24,66 @@ def database_path(app: Flask) -> Path:
     return path
 
 
+class _ThreadConnection:
+    """One thread's connection, held in thread-local storage (see Database.connection)."""
+
+    __slots__ = ("conn", "__weakref__")
+
+    def __init__(self, conn: sqlite3.Connection):
+        self.conn = conn
+
+
 class Database:
     def __init__(self, path: str | os.PathLike):
         self.path = str(path)
         self._local = threading.local()
-        self._all: list[sqlite3.Connection] = []
+        self._all: set[sqlite3.Connection] = set()
         self._lock = threading.Lock()
+        self._write_lock = threading.RLock()
 
     def connection(self) -> sqlite3.Connection:
-        conn = getattr(self._local, "conn", None)
-        if conn is None:
+        holder = getattr(self._local, "holder", None)
+        if holder is None:
             conn = sqlite3.connect(self.path, timeout=10.0, isolation_level=None, check_same_thread=False)
             conn.row_factory = sqlite3.Row
             conn.execute("PRAGMA journal_mode=WAL")
             # FULL: a commit is on disk before we answer 2xx, even if power is cut right after.
             conn.execute("PRAGMA synchronous=FULL")
             conn.execute("PRAGMA foreign_keys=ON")
-            self._local.conn = conn
+            holder = _ThreadConnection(conn)
+            self._local.holder = holder
             with self._lock:
-                self._all.append(conn)
-        return conn
+                self._all.add(conn)
+            # Werkzeug's server (flask run) runs every request in a new thread. The thread's local
+            # data, and so the holder, goes when the thread ends; close its connection then, or
+            # each request would leak a connection, its page cache and three file descriptors.
+            weakref.finalize(holder, self._forget, conn)
+        return holder.conn
+
+    def _forget(self, conn: sqlite3.Connection) -> None:
+        with self._lock:
+            self._all.discard(conn)
+        try:
+            conn.close()
+        except sqlite3.Error:
+            pass
 
     @contextmanager
     def transaction(self) -> Iterator[sqlite3.Connection]:
         """BEGIN IMMEDIATE ... COMMIT, or ROLLBACK on any exception: never a half-written record."""
         conn = self.connection()
-        conn.execute("BEGIN IMMEDIATE")
-        try:
-            yield conn
-        except BaseException:
-            conn.execute("ROLLBACK")
-            raise
-        conn.execute("COMMIT")
+        # Writers of this process queue on a lock, not in SQLite's busy handler: that one retries
+        # with sleeps of up to 100 ms, which under 8 concurrent writers gave p99 latencies of 200 ms
+        # for 2 ms writes. The lock hands over the moment a commit ends. (Re-entrant only so that a
+        # nested call fails with SQLite's clear error instead of deadlocking.)
+        with self._write_lock:
+            conn.execute("BEGIN IMMEDIATE")
+            try:
+                yield conn
+            except BaseException:
+                conn.execute("ROLLBACK")
+                raise
+            conn.execute("COMMIT")
 
     def ensure_schema(self, ddl: str) -> None:
         with self.transaction() as conn:

@@ -69,13 +69,15 @@ class RosPeer:
             raise RuntimeError(f"peer: {reply['message']}")
         return reply
 
-    def subscribe(self, topic: str, type_name: str, qos: str = "default", max_items: int = 64) -> None:
+    def subscribe(self, topic: str, type_name: str, qos: str | int = "default", max_items: int = 64) -> None:
+        """qos: a profile name (rover_web.ros.qos) or a keep-last depth, for a subscriber that must not
+        drop messages while this test process is busy reading them."""
         self._call(op="sub", topic=topic, type=type_name, qos=qos, max_items=max_items)
 
     def unsubscribe(self, topic: str) -> None:
         self._call(op="unsub", topic=topic)
 
-    def advertise(self, topic: str, type_name: str, qos: str = "default") -> None:
+    def advertise(self, topic: str, type_name: str, qos: str | int = "default") -> None:
         self._call(op="pub", topic=topic, type=type_name, qos=qos)
 
     def publish(self, topic: str, msg: dict) -> None:

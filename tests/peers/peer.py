@@ -1,6 +1,7 @@
 """A real rclpy node in its own process, driven by the tests over stdin/stdout (JSON lines).
 
 Commands (stdin):  {"op": "sub"|"pub", "topic", "type", "qos"}  {"op": "send", "topic", "msg"}
+                   ("qos": a profile name, or an int: reliable, volatile, keep-last of that depth)
                    {"op": "wait_match", "topic", "count", "timeout"}  {"op": "quit"}
                    {"op": "graph", "count": [topics]} -> ack with nodes, topics, pub/sub counts
 Events (stdout):   {"event": "ready"}  {"event": "ack", "op"}  {"event": "error", "message"}
@@ -23,6 +24,10 @@ from rover_web.ros.convert import dict_to_message, message_to_dict
 from rover_web.ros.typesupport import message_class
 
 out_lock = threading.Lock()
+
+
+def profile(name):
+    return qos.profile("default", depth=name) if isinstance(name, int) else qos.profile(name)
 
 
 def emit(**event):
@@ -63,10 +68,10 @@ def main():
                     emit(event="msg", topic=topic, t=t, msg=message_to_dict(msg, max_items=cmd.get("max_items", 64)))
 
                 subs[topic] = node.create_subscription(message_class(cmd["type"]), topic, callback,
-                                                       qos.profile(cmd.get("qos", "default")))
+                                                       profile(cmd.get("qos", "default")))
             elif op == "pub":
                 pubs[cmd["topic"]] = (cmd["type"], node.create_publisher(
-                    message_class(cmd["type"]), cmd["topic"], qos.profile(cmd.get("qos", "default"))))
+                    message_class(cmd["type"]), cmd["topic"], profile(cmd.get("qos", "default"))))
             elif op == "send":
                 type_name, pub = pubs[cmd["topic"]]
                 pub.publish(dict_to_message(type_name, cmd.get("msg", {})))

@@ -1,0 +1,306 @@
+// The GPS waypoints panel: MapLibre map (no remote sources), numbered draggable markers, the
+// mission list, and the robot's fix with its track. The server owns the mission: every edit is an
+// HTTP call, and what is drawn is whatever the `waypoints` channel (or a fresh GET) says, newest
+// revision wins. Untrusted text (labels) only ever goes through textContent.
+import { on } from './live.js';
+
+const el = document.getElementById('wp-map');
+if (el) init(el);
+
+function $(id) { return document.getElementById(id); }
+
+function fmtLatLng(lat, lng) {
+  const ns = lat >= 0 ? 'N' : 'S';
+  const ew = lng >= 0 ? 'E' : 'W';
+  return `${Math.abs(lat).toFixed(7)}° ${ns}, ${Math.abs(lng).toFixed(7)}° ${ew}`;
+}
+
+async function api(method, url, body) {
+  const init = { method, headers: { Accept: 'application/json' } };
+  if (body !== undefined) {
+    init.headers['Content-Type'] = 'application/json';
+    init.body = typeof body === 'string' ? body : JSON.stringify(body);
+  }
+  const res = await fetch(url, init);
+  let data = null;
+  try { data = await res.json(); } catch { /* an empty or non-JSON answer */ }
+  if (!res.ok) throw new Error((data && data.message) || `${res.status} ${res.statusText}`);
+  return data;
+}
+
+// --- the map's own style: nothing is fetched unless a local basemap is installed ---
+
+function buildStyle(cfg) {
+  const style = {
+    version: 8,
+    sources: {
+      graticule: { type: 'geojson', data: { type: 'FeatureCollection', features: [] } },
+      track: { type: 'geojson', data: { type: 'FeatureCollection', features: [] } },
+    },
+    layers: [{ id: 'background', type: 'background', paint: { 'background-color': '#17212b' } }],
+  };
+  if (cfg.basemap) {
+    const { name, ...source } = cfg.basemap;
+    style.sources.basemap = { type: 'raster', ...source };
+    style.layers.push({ id: 'basemap', type: 'raster', source: 'basemap' });
+  }
+  style.layers.push(
+    { id: 'graticule', type: 'line', source: 'graticule',
+      paint: { 'line-color': cfg.basemap ? '#00000033' : '#5b6b7b', 'line-width': 1 } },
+    { id: 'track', type: 'line', source: 'track',
+      layout: { 'line-cap': 'round', 'line-join': 'round' },
+      paint: { 'line-color': '#58a6ff', 'line-width': 3, 'line-opacity': 0.85 } },
+  );
+  return style;
+}
+
+const GRID_STEPS = [30, 10, 5, 2, 1, 0.5, 0.2, 0.1, 0.05, 0.02, 0.01, 0.005, 0.002, 0.001,
+  0.0005, 0.0002, 0.0001, 0.00005, 0.00002, 0.00001];
+
+function graticule(bounds) {
+  const west = Math.max(-180, bounds.getWest());
+  const east = Math.min(180, bounds.getEast());
+  const south = Math.max(-85, bounds.getSouth());
+  const north = Math.min(85, bounds.getNorth());
+  const span = Math.max(east - west, north - south);
+  const step = GRID_STEPS.find((s) => span / s >= 4) || GRID_STEPS[GRID_STEPS.length - 1];
+  const features = [];
+  const line = (coordinates) => features.push({ type: 'Feature', properties: {}, geometry: { type: 'LineString', coordinates } });
+  for (let x = Math.ceil(west / step) * step; x <= east && features.length < 200; x += step) line([[x, south], [x, north]]);
+  for (let y = Math.ceil(south / step) * step; y <= north && features.length < 400; y += step) line([[west, y], [east, y]]);
+  return { type: 'FeatureCollection', features };
+}
+
+function init(container) {
+  const cfg = JSON.parse(container.dataset.config);
+  const list = $('wp-list');
+  const message = $('wp-message');
+  const state = { mission: { revision: -1, waypoints: [] }, markers: new Map(), dragging: new Set() };
+  let map = null;
+  let loaded = false;
+  let robot = null;
+  let pendingTrack = null;
+
+  const say = (text, kind = '') => { message.textContent = text; message.dataset.kind = kind; };
+
+  // --- the mission: list and markers ---
+
+  function render(mission, force = false) {
+    if (!mission || (!force && mission.revision < state.mission.revision)) return;
+    state.mission = mission;
+    list.dataset.revision = String(mission.revision);
+    $('wp-count').textContent = String(mission.waypoints.length);
+    list.replaceChildren(...mission.waypoints.map((w, i) => listItem(w, i, mission.waypoints.length)));
+    if (map) drawMarkers(mission.waypoints);
+  }
+
+  function listItem(w, i, n) {
+    const li = document.createElement('li');
+    li.dataset.id = String(w.id);
+    const num = document.createElement('span');
+    num.className = 'wp-num';
+    num.textContent = String(i + 1);
+    const label = document.createElement('span');
+    label.className = 'wp-label';
+    label.textContent = w.label;
+    const coords = document.createElement('span');
+    coords.className = 'wp-coords';
+    coords.textContent = fmtLatLng(w.lat, w.lng);
+    const buttons = document.createElement('span');
+    buttons.className = 'wp-buttons';
+    const button = (text, title, fn, disabled = false) => {
+      const b = document.createElement('button');
+      b.type = 'button';
+      b.textContent = text;
+      b.title = title;
+      b.disabled = disabled;
+      b.addEventListener('click', fn);
+      buttons.append(b);
+    };
+    button('↑', 'earlier in the mission', () => edit('PATCH', w.id, { index: i - 1 }), i === 0);
+    button('↓', 'later in the mission', () => edit('PATCH', w.id, { index: i + 1 }), i === n - 1);
+    button('✕', 'delete this waypoint', () => edit('DELETE', w.id));
+    li.append(num, label, coords, buttons);
+    return li;
+  }
+
+  function markerElement() {
+    const node = document.createElement('div');
+    node.className = 'wp-marker';
+    return node;
+  }
+
+  function drawMarkers(waypoints) {
+    const seen = new Set();
+    waypoints.forEach((w, i) => {
+      seen.add(w.id);
+      let marker = state.markers.get(w.id);
+      if (!marker) {
+        marker = new maplibregl.Marker({ element: markerElement(), draggable: true });
+        marker.on('dragstart', () => state.dragging.add(w.id));
+        marker.on('dragend', () => {
+          state.dragging.delete(w.id);
+          const { lng, lat } = marker.getLngLat().wrap();
+          edit('PATCH', w.id, { lng, lat });
+        });
+        marker.setLngLat([w.lng, w.lat]).addTo(map);
+        state.markers.set(w.id, marker);
+      } else if (!state.dragging.has(w.id)) {
+        marker.setLngLat([w.lng, w.lat]);
+      }
+      const key = JSON.stringify([i, w.label, w.lat, w.lng]);
+      if (marker.wpKey === key) return;  // unchanged: keep an open popup open
+      marker.wpKey = key;
+      const node = marker.getElement();
+      node.textContent = String(i + 1);
+      node.dataset.id = String(w.id);
+      node.title = `${i + 1}${w.label ? ` · ${w.label}` : ''} · ${fmtLatLng(w.lat, w.lng)}`;
+      marker.setPopup(popupFor(w, i));
+    });
+    for (const [id, marker] of state.markers) {
+      if (!seen.has(id)) { marker.remove(); state.markers.delete(id); }
+    }
+  }
+
+  function popupFor(w, i) {
+    const box = document.createElement('div');
+    box.className = 'wp-popup';
+    const title = document.createElement('strong');
+    title.textContent = `Waypoint ${i + 1}${w.label ? `: ${w.label}` : ''}`;
+    const where = document.createElement('div');
+    where.textContent = fmtLatLng(w.lat, w.lng);
+    const del = document.createElement('button');
+    del.type = 'button';
+    del.className = 'danger';
+    del.textContent = 'Delete';
+    del.addEventListener('click', () => edit('DELETE', w.id));
+    box.append(title, where, del);
+    return new maplibregl.Popup({ offset: 16, closeButton: true }).setDOMContent(box);
+  }
+
+  async function refresh() {
+    try { render(await api('GET', '/api/waypoints')); } catch (err) { say(`Could not reload the list: ${err.message}`, 'error'); }
+  }
+
+  async function edit(method, id, body) {
+    try {
+      await api(method, `/api/waypoints/${id}`, body);
+      say('');
+    } catch (err) {
+      say(err.message, 'error');
+      render(state.mission, true);  // a refused drag snaps back
+    }
+    await refresh();
+  }
+
+  async function addAt(lngLat) {
+    const { lng, lat } = lngLat.wrap();
+    try {
+      const res = await api('POST', '/waypoints', { lng, lat });
+      say(`Waypoint ${res.waypoint.index + 1} added at ${fmtLatLng(res.waypoint.lat, res.waypoint.lng)}`);
+    } catch (err) {
+      say(err.message, 'error');
+    }
+    await refresh();
+  }
+
+  $('wp-send').addEventListener('click', async () => {
+    try {
+      const res = await api('POST', '/api/waypoints/send', { revision: state.mission.revision });
+      say(`Mission of ${res.sent} waypoints sent on ${res.topic}`);
+    } catch (err) { say(err.message, 'error'); }
+  });
+  $('wp-clear').addEventListener('click', async () => {
+    const n = state.mission.waypoints.length;
+    if (!n || !window.confirm(`Delete all ${n} waypoints?`)) return;
+    try { await api('DELETE', '/api/waypoints'); say('All waypoints deleted'); } catch (err) { say(err.message, 'error'); }
+    await refresh();
+  });
+  $('wp-import').addEventListener('change', async (ev) => {
+    const file = ev.target.files[0];
+    ev.target.value = '';
+    if (!file) return;
+    try {
+      const res = await api('POST', '/api/waypoints/geojson', await file.text());
+      say(`Imported ${res.count} waypoints from ${file.name}`);
+    } catch (err) { say(`${file.name}: ${err.message}`, 'error'); }
+    await refresh();
+  });
+
+  // --- the robot ---
+
+  function showFix(fix) {
+    const out = $('wp-fix');
+    if (!fix) return;
+    out.dataset.fix = fix.fix ? 'yes' : 'no';
+    if (fix.fix) {
+      out.dataset.lng = String(fix.lng);
+      out.dataset.lat = String(fix.lat);
+      out.textContent = fmtLatLng(fix.lat, fix.lng) + (fix.accuracy_m !== null ? ` ±${fix.accuracy_m} m` : '');
+    } else {
+      delete out.dataset.lng;
+      delete out.dataset.lat;
+      out.textContent = `no fix (${fix.reason})`;
+    }
+    if (!map) return;
+    if (fix.fix) {
+      if (!robot) {
+        const node = document.createElement('div');
+        node.className = 'wp-robot';
+        node.title = 'robot (GPS fix)';
+        robot = new maplibregl.Marker({ element: node }).setLngLat([fix.lng, fix.lat]).addTo(map);
+      }
+      robot.setLngLat([fix.lng, fix.lat]);
+      robot.getElement().dataset.fix = 'yes';
+    } else if (robot) {
+      robot.getElement().dataset.fix = 'no';  // kept where it was last known, greyed: never at 0,0
+    }
+    const track = { type: 'FeatureCollection', features: fix.track.length > 1
+      ? [{ type: 'Feature', properties: {}, geometry: { type: 'LineString', coordinates: fix.track } }] : [] };
+    if (loaded) map.getSource('track').setData(track); else pendingTrack = track;
+  }
+
+  // --- the map ---
+
+  try {
+    map = new maplibregl.Map({
+      container, style: buildStyle(cfg), center: cfg.center, zoom: cfg.zoom,
+      attributionControl: { compact: true }, dragRotate: false, pitchWithRotate: false,
+    });
+  } catch (err) {
+    const note = $('wp-map-note');
+    note.hidden = false;
+    note.textContent = `The map cannot be shown in this browser (${err.message}); the list still works.`;
+    map = null;
+  }
+  if (map) {
+    map.touchZoomRotate.disableRotation();
+    map.addControl(new maplibregl.NavigationControl({ showCompass: false }));
+    map.addControl(new maplibregl.ScaleControl({ unit: 'metric' }));
+    map.on('error', (e) => {
+      // A tile the local store does not have is normal at its edges; anything else is a bug.
+      if (e.sourceId === 'basemap' && e.error && e.error.status === 404) return;
+      console.error('map error', e.error || e);
+    });
+    const updateGrid = () => map.getSource('graticule').setData(graticule(map.getBounds()));
+    map.on('load', () => {
+      loaded = true;
+      container.dataset.ready = 'yes';
+      updateGrid();
+      if (pendingTrack) map.getSource('track').setData(pendingTrack);
+    });
+    map.on('moveend', () => { if (loaded) updateGrid(); });
+    map.on('click', (e) => {
+      const target = e.originalEvent && e.originalEvent.target;
+      if (target && target.closest && target.closest('.maplibregl-marker, .maplibregl-popup')) return;
+      addAt(e.lngLat);
+    });
+    map.on('mousemove', (e) => { $('wp-cursor').textContent = fmtLatLng(e.lngLat.lat, e.lngLat.lng); });
+    window.roverWaypointsMap = map;  // for the browser tests and the curious operator's console
+  }
+
+  render(JSON.parse($('wp-mission').textContent));
+  showFix(JSON.parse($('wp-fix-state').textContent));
+  on('waypoints', (mission) => render(mission));
+  on('fix', showFix);
+}
