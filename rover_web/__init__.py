@@ -22,7 +22,7 @@ from .events import EventHub
 ROOT = Path(__file__).resolve().parent.parent
 
 # Feature modules, each with init_app(app, rover): routes, subscriptions, channels, panels.
-FEATURES = ("telemetry",)
+FEATURES = ("telemetry", "scan_the_code")
 
 log = logging.getLogger(__name__)
 

@@ -71,6 +71,21 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("CMD_VEL_FRAME_ID", "base_link", "str", "frame_id of TwistStamped commands"),
     Setting("MAX_LINEAR_MPS", 5.0, "float", "linear speed at full joystick deflection (m/s)", 0.0, 100),
     Setting("MAX_ANGULAR_RPS", 2.0, "float", "turn rate at full joystick deflection (rad/s)", 0.0, 100),
+    # --- scan the code ---
+    Setting("LIGHT_SEQUENCE_TOPIC", "/light_sequence", "topic",
+            "std_msgs/String colour names from the light tower detector (Scan the Code)"),
+    Setting("LIGHT_SEQUENCE_QOS", "default", "str",
+            "QoS of that subscription: default (reliable) or sensor_data (best effort, for best-effort detectors)",
+            choices=("default", "sensor_data")),
+    Setting("LIGHT_COLOURS", ["red", "green", "blue", "yellow"], "list",
+            "colours a code is made of (case-insensitive); black ends a cycle, anything else is unknown"),
+    Setting("LIGHT_STALE_AFTER_S", 3.0, "float", "the light sequence is shown stale after this long without a message",
+            0.1, 3600),
+    Setting("CODE_TOPIC", "/scan_the_code/code", "topic",
+            "where each confirmed code is published: std_msgs/String such as `red,green,blue`, transient local"),
+    Setting("CODE_CONFIRM_CYCLES", 1, "int",
+            "complete cycles in a row that must agree before a code is confirmed and published", 1, 20),
+    Setting("CODE_HISTORY_LENGTH", 10, "int", "completed cycles (codes and invalid ones) kept in the history", 1, 100),
 )
 
 _BY_NAME = {PREFIX + s.name: s for s in SETTINGS}
