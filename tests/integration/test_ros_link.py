@@ -27,7 +27,7 @@ def test_peer_message_reaches_sse_client_and_status(live_server, ros_peer, sse_c
     peer.wait_match("/odom")  # the app's subscription was discovered
     stream = sse_client(live_server.url + "/api/events?channels=status,odom")
     warm_up_until_received(peer, live_server.rover)
-    baseline = live_server.rover.runtime.topic_stats(2.0)[0]["count"]
+    baseline = next(t for t in live_server.rover.runtime.topic_stats(2.0) if t["topic"] == "/odom")["count"]
     started = time.monotonic()
     for i in range(30):
         peer.publish("/odom", odom(x=i * 0.1, linear=0.5))
@@ -90,4 +90,8 @@ def test_two_apps_in_one_process_do_not_share_ros_state(app_factory, ros_peer):
         assert time.monotonic() < deadline
         peer.publish("/b/odom", odom(2.0))
         time.sleep(0.05)
-    assert "/app_b" in peer.graph()["nodes"]
+    # Node names travel on their own discovery topic and can lag the data: wait for them.
+    deadline = time.monotonic() + 10
+    while "/app_b" not in peer.graph()["nodes"]:
+        assert time.monotonic() < deadline, "the peer never saw /app_b in the graph"
+        time.sleep(0.05)
