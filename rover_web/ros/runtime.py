@@ -83,7 +83,8 @@ class RosRuntime:
             self.executor.shutdown(timeout_sec=timeout_s)
         except Exception:
             log.exception("executor shutdown failed")
-        self._thread.join(timeout_s)
+        if self._thread.ident is not None:  # a feature's init_app can fail before start()
+            self._thread.join(timeout_s)
         try:
             self.node.destroy_node()
         finally:
