@@ -22,7 +22,7 @@ from .events import EventHub
 ROOT = Path(__file__).resolve().parent.parent
 
 # Feature modules, each with init_app(app, rover): routes, subscriptions, channels, panels.
-FEATURES = ("telemetry", "teleop", "waypoints", "panels", "livemap", "camera", "topics")
+FEATURES = ("telemetry", "teleop", "waypoints", "scan_the_code", "panels", "livemap", "camera", "topics")
 
 # Modules with init_cli(app): `flask --app rover_web <command>` commands. They are registered
 # before (and without) the ROS node, so a command such as `flask tiles fetch` never joins the ROS

@@ -145,6 +145,21 @@ SETTINGS: tuple[Setting, ...] = (
             "arrays and byte fields longer than this are shown cut, with their length", 1, 10000),
     Setting("TOPICS_ECHO_IDLE_TIMEOUT_S", 2.0, "float",
             "how long a topic browser subscription stays after its last viewer leaves", 0.0, 600),
+    # --- scan the code ---
+    Setting("LIGHT_SEQUENCE_TOPIC", "/light_sequence", "topic",
+            "std_msgs/String colour names from the light tower detector (Scan the Code)"),
+    Setting("LIGHT_SEQUENCE_QOS", "default", "str",
+            "QoS of that subscription: default (reliable) or sensor_data (best effort, for best-effort detectors)",
+            choices=("default", "sensor_data")),
+    Setting("LIGHT_COLOURS", ["red", "green", "blue", "yellow"], "list",
+            "colours a code is made of (case-insensitive); black ends a cycle, anything else is unknown"),
+    Setting("LIGHT_STALE_AFTER_S", 3.0, "float", "the light sequence is shown stale after this long without a message",
+            0.1, 3600),
+    Setting("CODE_TOPIC", "/scan_the_code/code", "topic",
+            "where each confirmed code is published: std_msgs/String such as `red,green,blue`, transient local"),
+    Setting("CODE_CONFIRM_CYCLES", 1, "int",
+            "complete cycles in a row that must agree before a code is confirmed and published", 1, 20),
+    Setting("CODE_HISTORY_LENGTH", 10, "int", "completed cycles (codes and invalid ones) kept in the history", 1, 100),
 )
 
 _BY_NAME = {PREFIX + s.name: s for s in SETTINGS}

@@ -22,7 +22,8 @@ def pytest_configure(config):
     os.environ.setdefault("ROS_DOMAIN_ID", os.environ.get("ROVER_WEB_TEST_DOMAIN_ID") or str(random.randint(1, 200)))
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     os.environ.pop("ROS_STATIC_PEERS", None)
-    # The app refuses unknown ROVER_WEB_* names, and a developer's own settings must not leak in.
+    # Every ROVER_WEB_* name goes, ROVER_WEB_TEST_DOMAIN_ID too (it is used above): the app refuses
+    # unknown ROVER_WEB_* settings, in this process and in the servers and simulators tests start.
     for key in [k for k in os.environ if k.startswith("ROVER_WEB_")]:
         del os.environ[key]
 
