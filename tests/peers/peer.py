@@ -16,7 +16,7 @@ import time
 
 import rclpy
 from rclpy.context import Context
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.signals import SignalHandlerOptions
 
 from rover_web.ros import qos
@@ -41,7 +41,8 @@ def main():
     context = Context()
     rclpy.init(context=context, signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node(sys.argv[1] if len(sys.argv) > 1 else "test_peer", context=context)
-    executor = MultiThreadedExecutor(context=context)
+    # Single-threaded: the multi-threaded executor busy-spins and delivers late under load.
+    executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
     pubs, subs = {}, {}
 
