@@ -89,9 +89,12 @@ class SseFleet:
         """Call on_event(arrival_monotonic, event_name, data_dict) for every frame for `seconds`."""
         end = time.monotonic() + seconds
         while (remaining := end - time.monotonic()) > 0:
-            for key, _ in self.sel.select(remaining):
+            ready = self.sel.select(remaining)
+            # Every socket in this batch was readable when select returned: stamp them all then,
+            # so this one Python reader's own parsing time is not counted against the server.
+            t = time.monotonic()
+            for key, _ in ready:
                 s = key.fileobj
-                t = time.monotonic()
                 data = s.recv(262144)
                 if not data:
                     self.sel.unregister(s)
