@@ -10,6 +10,8 @@ import sys
 import time
 
 import rclpy
+from rclpy.event_handler import SubscriptionEventCallbacks
+from rclpy.parameter import Parameter
 from geometry_msgs.msg import Twist
 from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
@@ -23,7 +25,8 @@ def main() -> None:
     args = parser.parse_args()
     context = Context()
     rclpy.init(context=context, signal_handler_options=SignalHandlerOptions.NO)
-    node = rclpy.create_node("bench_cmd_vel_subscriber", context=context)
+    node = rclpy.create_node("bench_cmd_vel_subscriber", context=context, start_parameter_services=False,
+                             parameter_overrides=[Parameter("start_type_description_service", value=False)])
     out = sys.stdout
 
     def on_twist(msg: Twist) -> None:
@@ -31,8 +34,11 @@ def main() -> None:
         out.write(f"{t} {msg.linear.x!r} {msg.angular.z!r}\n")
         out.flush()
 
+    # A lean node (no parameter services, no QoS-event handlers), like the app's own: the bench
+    # measures the server, not this subscriber's executor re-adding waitables on every spin.
     sub = node.create_subscription(Twist, args.topic, on_twist,
-                                   QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE))
+                                   QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE),
+                                   event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False))
     deadline = time.monotonic() + 20
     while sub.get_publisher_count() == 0 and time.monotonic() < deadline:
         time.sleep(0.01)
