@@ -136,6 +136,11 @@ class EventHub:
             return frozenset(self._channels)
 
     @property
+    def lock(self):
+        """The hub's (reentrant) lock, for a consumer that must hold it around several polls."""
+        return self._cond
+
+    @property
     def client_count(self) -> int:
         with self._cond:
             return self._clients

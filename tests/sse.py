@@ -11,7 +11,8 @@ from urllib.parse import urlsplit
 
 class SseClient:
     def __init__(self, url: str, headers: dict[str, str] | None = None, connect_timeout: float = 10.0,
-                 read_delay_s: float = 0.0):
+                 read_delay_s: float = 0.0, keep_events: bool = True):
+        """`keep_events=False` keeps only the newest event of each name (memory tests, long runs)."""
         parts = urlsplit(url)
         self.sock = socket.create_connection((parts.hostname, parts.port), timeout=connect_timeout)
         path = parts.path + ("?" + parts.query if parts.query else "")
@@ -20,6 +21,7 @@ class SseClient:
         self.sock.sendall(("\r\n".join(lines) + "\r\n\r\n").encode())
         self.sock.settimeout(None)
         self.read_delay_s = read_delay_s
+        self.keep_events = keep_events
         self.status: int | None = None
         self.events: list[dict] = []
         self.comments: list[tuple[float, str]] = []
@@ -95,6 +97,8 @@ class SseClient:
         if event["data"]:
             event["json"] = json.loads(event["data"])
             with self._cond:
+                if not self.keep_events:
+                    self.events = [e for e in self.events if e["event"] != event["event"]]
                 self.events.append(event)
                 self._cond.notify_all()
 
@@ -110,7 +114,7 @@ class SseClient:
                 for event in self.events[seen:]:
                     if event["event"] == name and predicate(event["json"]):
                         return event
-                seen = len(self.events)
+                seen = len(self.events) if self.keep_events else 0
                 remaining = deadline - time.monotonic()
                 if remaining <= 0 or self.closed.is_set():
                     raise TimeoutError(f"no matching {name!r} event within {timeout} s ({len(self.events)} events)")
