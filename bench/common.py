@@ -10,6 +10,7 @@ import socket
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -41,6 +42,9 @@ class Server:
     def __init__(self, env: dict[str, str], args: list[str] | None = None):
         self.port = free_port()
         self.url = f"http://127.0.0.1:{self.port}"
+        # A throwaway database: a bench must never touch the operator's waypoints or e-stop latch.
+        self._tmp = tempfile.TemporaryDirectory(prefix="rover_web-bench-")
+        env = {**env, "ROVER_WEB_DB_PATH": env.get("ROVER_WEB_DB_PATH") or os.path.join(self._tmp.name, "bench.sqlite3")}
         cmd = args or [sys.executable, "-m", "flask", "--app", "rover_web", "run", "--no-reload",
                        "--host", "127.0.0.1", "--port", str(self.port)]
         self.proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -69,6 +73,7 @@ class Server:
             self.proc.wait(10)
         except subprocess.TimeoutExpired:
             self.proc.kill()
+        self._tmp.cleanup()
 
 
 class SseFleet:

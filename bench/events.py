@@ -10,7 +10,7 @@ import subprocess
 import sys
 import time
 
-from common import ROOT, Server, SseFleet, machine, percentile, ros_env, summary_ms
+from common import ROOT, Server, SseFleet, machine, ros_env, summary_ms
 
 
 def run(clients: int, seconds: float, env: dict) -> dict:

@@ -189,12 +189,12 @@ def ros_peer():
 
 
 class SimProcess:
-    """`python -m rover_web.sim` with the given arguments, in its own process."""
+    """`python -m rover_web.sim` (or one part, e.g. module="rover_web.sim.drone") in its own process."""
 
-    def __init__(self, args: list[str]):
+    def __init__(self, args: list[str], module: str = "rover_web.sim"):
         from tests.rospeer import subprocess_env
 
-        self.proc = subprocess.Popen([sys.executable, "-m", "rover_web.sim", *args], cwd=ROOT,
+        self.proc = subprocess.Popen([sys.executable, "-m", module, *args], cwd=ROOT,
                                      env=subprocess_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                      text=True)
         line = self.proc.stdout.readline()

@@ -2,45 +2,20 @@
 
 from __future__ import annotations
 
-import signal
-import subprocess
-import sys
-import threading
 import time
 
 import pytest
 import requests
 
-from tests.rospeer import ROOT, subprocess_env
+from tests.conftest import SimProcess
 
 JSON = {"Content-Type": "application/json"}
 STRING = "std_msgs/msg/String"
 
 
-class DroneProcess:
+def drone_process(*args: str) -> SimProcess:
     """`python -m rover_web.sim.drone` (the drone part run alone) in its own process."""
-
-    def __init__(self, *args: str):
-        self.proc = subprocess.Popen([sys.executable, "-m", "rover_web.sim.drone", *args], cwd=ROOT,
-                                     env=subprocess_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-        line = self.proc.stdout.readline()
-        if "simulator running" not in line:
-            raise RuntimeError(f"drone simulator did not start: {line}{self.proc.stdout.read()}")
-        self.output: list[str] = []
-        threading.Thread(target=self._drain, daemon=True).start()
-
-    def _drain(self) -> None:
-        for line in self.proc.stdout:
-            self.output.append(line)
-
-    def stop(self) -> int:
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGINT)
-            try:
-                self.proc.wait(10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-        return self.proc.wait(5)
+    return SimProcess(list(args), module="rover_web.sim.drone")
 
 
 @pytest.fixture
@@ -48,8 +23,8 @@ def drone_sim():
     """Start the simulated drone with the given arguments; stopped at the end of the test."""
     started = []
 
-    def start(*args: str) -> DroneProcess:
-        sim = DroneProcess(*args)
+    def start(*args: str) -> SimProcess:
+        sim = drone_process(*args)
         started.append(sim)
         return sim
 

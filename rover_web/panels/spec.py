@@ -339,7 +339,7 @@ def _control(cid: str, c: Any, where: _Where, displays: dict[str, DisplaySpec]) 
                                   "max_length")
             fields["max_length"] = max_length
         elif "max_length" in c:
-            raise where.error(f"only std_msgs/String inputs have a length; remove 'max_length'", "max_length")
+            raise where.error("only std_msgs/String inputs have a length; remove 'max_length'", "max_length")
     enabled_when = _enabled_when(c.get("enabled_when", {}), where, displays)
     confirm = _bool(c, "confirm", where, False)
     requires_unlock = _bool(c, "requires_unlock", where, True)

@@ -19,7 +19,6 @@ import os
 import time
 from dataclasses import dataclass
 
-import rclpy
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry, Path
 from rclpy.node import Node

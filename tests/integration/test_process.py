@@ -7,7 +7,6 @@ import sys
 import time
 
 import pytest
-import requests
 
 from tests.rospeer import ROOT, subprocess_env
 

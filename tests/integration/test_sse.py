@@ -1,11 +1,9 @@
 """The SSE endpoint served for real: framing, snapshot, conflation, keep-alive, clean-up, many clients."""
 
 import gc
-import socket
 import time
 
 import psutil
-import pytest
 import requests
 
 
