@@ -8,6 +8,7 @@ uses little CPU however long it runs.
 from __future__ import annotations
 
 import argparse
+import sys
 import array
 import time
 
@@ -111,11 +112,8 @@ def from_arguments(args: argparse.Namespace, context) -> CameraSim:
 
 
 def main(argv: list[str] | None = None) -> None:
-    from .runner import run_nodes
-    parser = argparse.ArgumentParser(description=__doc__)
-    add_arguments(parser)
-    args = parser.parse_args(argv)
-    run_nodes(lambda ctx: [from_arguments(args, ctx)])
+    from .runner import run_part
+    run_part(sys.modules[__name__], argv)
 
 
 if __name__ == "__main__":

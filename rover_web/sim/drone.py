@@ -20,6 +20,7 @@ manoeuvre takes --drone-transition-s, so tests can make the drone fast.
 from __future__ import annotations
 
 import argparse
+import sys
 import math
 import threading
 import time
@@ -225,12 +226,8 @@ def from_arguments(args: argparse.Namespace, context) -> DroneSim:
 
 
 def main(argv: list[str] | None = None) -> None:
-    from .runner import run_nodes
-    parser = argparse.ArgumentParser(prog="python -m rover_web.sim.drone", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    add_arguments(parser)
-    args = parser.parse_args(argv)
-    run_nodes(lambda ctx: [from_arguments(args, ctx)])
+    from .runner import run_part
+    run_part(sys.modules[__name__], argv)
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@ The code it chose is the truth the tests compare with: published on /light_buoy/
 from __future__ import annotations
 
 import argparse
+import sys
 import random
 import time
 from typing import Sequence
@@ -176,12 +177,8 @@ def from_arguments(args: argparse.Namespace, context) -> LightBuoy:
 
 
 def main(argv: list[str] | None = None) -> None:
-    from .runner import run_nodes
-    parser = argparse.ArgumentParser(prog="python -m rover_web.sim.light_buoy", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    add_arguments(parser)
-    args = parser.parse_args(argv)
-    run_nodes(lambda ctx: [from_arguments(args, ctx)])
+    from .runner import run_part
+    run_part(sys.modules[__name__], argv)
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@ navigating robot.
 from __future__ import annotations
 
 import argparse
+import sys
 import math
 import os
 import time
@@ -290,11 +291,8 @@ def from_arguments(args: argparse.Namespace, context) -> RoverSim:
 
 
 def main(argv: list[str] | None = None) -> None:
-    from .runner import run_nodes
-    parser = argparse.ArgumentParser(description=__doc__)
-    add_arguments(parser)
-    args = parser.parse_args(argv)
-    run_nodes(lambda ctx: [from_arguments(args, ctx)])
+    from .runner import run_part
+    run_part(sys.modules[__name__], argv)
 
 
 if __name__ == "__main__":

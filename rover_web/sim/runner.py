@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import signal
 import sys
 import threading
@@ -11,6 +12,16 @@ import rclpy
 from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.signals import SignalHandlerOptions
+
+
+def run_part(part, argv: list[str] | None = None) -> None:
+    """`python -m rover_web.sim.<part>`: one simulator part alone, with its own options."""
+    module = part.__spec__.name if part.__spec__ else part.__name__  # "__main__" under python -m
+    parser = argparse.ArgumentParser(prog=f"python -m {module}", description=part.__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    part.add_arguments(parser)
+    args = parser.parse_args(argv)
+    run_nodes(lambda context: [part.from_arguments(args, context)])
 
 
 def run_nodes(make_nodes: Callable[[Context], list]) -> None:
