@@ -37,16 +37,21 @@ def free_port() -> int:
 
 
 class Server:
-    """`flask --app rover_web run --no-reload` in its own process, so its CPU and RSS are its own."""
+    """The app in its own process, so its CPU and RSS are its own: `flask --app rover_web run
+    --no-reload`, or gunicorn with gunicorn.conf.py (kind="gunicorn"), on a free 127.0.0.1 port."""
 
-    def __init__(self, env: dict[str, str], args: list[str] | None = None):
+    def __init__(self, env: dict[str, str], kind: str = "flask"):
         self.port = free_port()
         self.url = f"http://127.0.0.1:{self.port}"
         # A throwaway database: a bench must never touch the operator's waypoints or e-stop latch.
         self._tmp = tempfile.TemporaryDirectory(prefix="rover_web-bench-")
         env = {**env, "ROVER_WEB_DB_PATH": env.get("ROVER_WEB_DB_PATH") or os.path.join(self._tmp.name, "bench.sqlite3")}
-        cmd = args or [sys.executable, "-m", "flask", "--app", "rover_web", "run", "--no-reload",
-                       "--host", "127.0.0.1", "--port", str(self.port)]
+        if kind == "gunicorn":
+            cmd = [sys.executable, "-m", "gunicorn", "-c", str(ROOT / "gunicorn.conf.py"),
+                   "--bind", f"127.0.0.1:{self.port}", "rover_web:create_app()"]
+        else:
+            cmd = [sys.executable, "-m", "flask", "--app", "rover_web", "run", "--no-reload",
+                   "--host", "127.0.0.1", "--port", str(self.port)]
         self.proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         self.ps = psutil.Process(self.proc.pid)
         deadline = time.monotonic() + 30
@@ -57,7 +62,8 @@ class Server:
             except requests.RequestException:
                 pass
             if time.monotonic() > deadline or self.proc.poll() is not None:
-                raise RuntimeError("server did not start")
+                self.stop()
+                raise RuntimeError(f"{kind} server did not start")
             time.sleep(0.1)
 
     def cpu_seconds(self) -> float:
@@ -68,11 +74,13 @@ class Server:
         return self.ps.memory_info().rss / 1e6
 
     def stop(self) -> None:
-        self.proc.terminate()
-        try:
-            self.proc.wait(10)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait(5)
         self._tmp.cleanup()
 
 

@@ -20,7 +20,6 @@ import random
 import selectors
 import socket
 import statistics
-import subprocess
 import sys
 import threading
 import time
@@ -30,58 +29,16 @@ from urllib.parse import quote
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-import psutil  # noqa: E402
 import requests  # noqa: E402
 
+from common import Server  # noqa: E402  (bench/ is on sys.path when run as a script)
+
 MAP = "Science Hall Basement"
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def percentile(values: list[float], q: float) -> float:
     ordered = sorted(values)
     return ordered[min(len(ordered) - 1, max(0, math.ceil(q / 100 * len(ordered)) - 1))]
-
-
-class Server:
-    def __init__(self, env: dict[str, str]):
-        self.port = free_port()
-        self.url = f"http://127.0.0.1:{self.port}"
-        self.proc = subprocess.Popen([sys.executable, "-m", "flask", "--app", "rover_web", "run", "--no-reload",
-                                      "--host", "127.0.0.1", "--port", str(self.port)],
-                                     cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        self.ps = psutil.Process(self.proc.pid)
-        deadline = time.monotonic() + 30
-        while True:
-            try:
-                if requests.get(self.url + "/api/status", timeout=1).ok:
-                    return
-            except requests.RequestException:
-                pass
-            if time.monotonic() > deadline or self.proc.poll() is not None:
-                self.stop()
-                raise RuntimeError("the server did not start")
-            time.sleep(0.1)
-
-    def cpu_s(self) -> float:
-        t = self.ps.cpu_times()
-        return t.user + t.system
-
-    def rss_mb(self) -> float:
-        return self.ps.memory_info().rss / 1e6
-
-    def stop(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait(5)
 
 
 class SseFleet:
@@ -191,11 +148,11 @@ def pose_latency(server: Server, publisher: PosePublisher, clients: int, seconds
         publisher.run(2.0, rate_hz)                 # warm-up: discovery, snapshots
         time.sleep(0.3)
         fleet.take()
-        cpu0, wall0 = server.cpu_s(), time.monotonic()
+        cpu0, wall0 = server.cpu_seconds(), time.monotonic()
         first_seq = publisher.seq + 1
         publisher.run(seconds, rate_hz)
         time.sleep(0.3)
-        cpu = (server.cpu_s() - cpu0) / (time.monotonic() - wall0) * 100
+        cpu = (server.cpu_seconds() - cpu0) / (time.monotonic() - wall0) * 100
         arrivals = fleet.take()
     finally:
         fleet.close()

@@ -20,7 +20,6 @@ import os
 import shutil
 import sqlite3
 import statistics
-import subprocess
 import sys
 import tempfile
 import threading
@@ -30,7 +29,7 @@ from pathlib import Path
 import psutil
 import requests
 
-from common import ROOT, Server, free_port, machine, percentile, ros_env
+from common import ROOT, Server, machine, percentile, ros_env
 
 sys.path.insert(0, str(ROOT))
 
@@ -56,32 +55,6 @@ def post_many(url: str, bodies: list[dict], results: list) -> None:
                     raise
         results.append((body["lng"], body["lat"], t0, time.monotonic(), response.status))
     conn.close()
-
-
-class App(Server):
-    """The app under gunicorn (gunicorn.conf.py, bound to a free port) or `flask run`."""
-
-    def __init__(self, env: dict[str, str], kind: str):  # noqa: super().__init__ starts flask only
-        self.port = free_port()
-        self.url = f"http://127.0.0.1:{self.port}"
-        if kind == "gunicorn":
-            cmd = [sys.executable, "-m", "gunicorn", "-c", str(ROOT / "gunicorn.conf.py"),
-                   "--bind", f"127.0.0.1:{self.port}", "rover_web:create_app()"]
-        else:
-            cmd = [sys.executable, "-m", "flask", "--app", "rover_web", "run", "--no-reload",
-                   "--host", "127.0.0.1", "--port", str(self.port)]
-        self.proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        self.ps = psutil.Process(self.proc.pid)
-        deadline = time.monotonic() + 30
-        while True:
-            try:
-                if requests.get(self.url + "/api/status", timeout=1).ok:
-                    return
-            except requests.RequestException:
-                pass
-            if time.monotonic() > deadline or self.proc.poll() is not None:
-                raise RuntimeError(f"{kind} did not start")
-            time.sleep(0.1)
 
 
 def server_cpu_seconds(server: Server) -> float:
@@ -166,7 +139,7 @@ def main() -> None:
     from tests.rospeer import RosPeer  # after the domain is set: the peer inherits this environment
     from tests.waypoint_helpers import warm_up_topic
 
-    server = App(env, args.server)
+    server = Server(env, kind=args.server)
     peer = RosPeer("bench_waypoints")
     try:
         peer.subscribe("/waypoints", FLOAT64_MULTI_ARRAY, qos=1000)
