@@ -7,7 +7,7 @@ import subprocess
 import sys
 import time
 
-from tests.rospeer import ROOT, subprocess_env
+from tests.rospeer import ROOT, stop_piped, subprocess_env
 
 
 class ImagePublisher:
@@ -32,16 +32,4 @@ class ImagePublisher:
         return reply
 
     def close(self) -> None:
-        if self.proc.poll() is None:
-            try:
-                self.proc.stdin.write("quit\n")
-                self.proc.stdin.flush()
-                self.proc.wait(5)
-            except (OSError, subprocess.TimeoutExpired):
-                self.proc.kill()
-                self.proc.wait(5)
-        for stream in (self.proc.stdin, self.proc.stdout):
-            try:
-                stream.close()
-            except OSError:
-                pass
+        stop_piped(self.proc, "quit")

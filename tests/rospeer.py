@@ -25,6 +25,23 @@ def subprocess_env(**extra: str) -> dict[str, str]:
     return env
 
 
+def stop_piped(proc: subprocess.Popen, quit_line: str) -> None:
+    """Ask a helper process driven over stdin to quit (kill it if it won't), then close its pipes."""
+    if proc.poll() is None:
+        try:
+            proc.stdin.write(quit_line + "\n")
+            proc.stdin.flush()
+            proc.wait(5)
+        except (OSError, subprocess.TimeoutExpired):
+            proc.kill()
+            proc.wait(5)
+    for stream in (proc.stdin, proc.stdout):
+        try:
+            stream.close()
+        except OSError:
+            pass
+
+
 class RosPeer:
     def __init__(self, name: str = "test_peer"):
         self._ids = itertools.count()
@@ -117,19 +134,7 @@ class RosPeer:
                 self._cond.wait(remaining)
 
     def close(self) -> None:
-        if self.proc.poll() is None:
-            try:
-                self.proc.stdin.write(json.dumps({"op": "quit"}) + "\n")
-                self.proc.stdin.flush()
-                self.proc.wait(5)
-            except (OSError, subprocess.TimeoutExpired):
-                self.proc.kill()
-                self.proc.wait(5)
-        for stream in (self.proc.stdin, self.proc.stdout):
-            try:
-                stream.close()
-            except OSError:
-                pass
+        stop_piped(self.proc, json.dumps({"op": "quit"}))
 
     def __enter__(self) -> "RosPeer":
         return self
