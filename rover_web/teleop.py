@@ -12,19 +12,18 @@ epochs, one operator at a time, e-stop latch). Velocity leaves the process only 
 
 from __future__ import annotations
 
-import json
 import logging
 import threading
 import time
 
 from flask import Blueprint, current_app, jsonify, request
-from flask_sock import ConnectionClosed, Sock
+from flask_sock import Sock
 
 from .config import ConfigError
 from .core import Rover
 from .http import ApiError, json_body
 from .teleop_control import REST_COMMANDS, Limits, Refused, Repeater, TeleopController
-from .teleop_protocol import Control, Drive, FrameError, parse_frame
+from .teleop_socket import InlineFrames, TeleopSocket
 from .teleop_store import EStopStore
 from .validate import InvalidInput, number, only_keys, text
 
@@ -33,8 +32,6 @@ log = logging.getLogger(__name__)
 CHANNEL = "teleop"
 # The commanded velocity can change at the joystick's event rate; browsers need far less.
 CHANNEL_MAX_HZ = 20.0
-# How often a socket thread with nothing received checks for messages to send and for shutdown.
-SOCKET_POLL_S = 0.05
 NAME_MAX_LEN = 40
 
 bp = Blueprint("teleop", __name__)
@@ -105,59 +102,14 @@ def _name(raw: str | None) -> str | None:
 
 # --- WebSocket ---
 
-def _send(ws, message: dict) -> None:
-    ws.send(json.dumps(message, separators=(",", ":"), allow_nan=False))
-
-
-def _handle_frame(controller: TeleopController, session, data, max_bytes: int) -> dict | None:
-    """One frame in; an error frame to answer with, or None. FrameError with a close code escapes."""
-    try:
-        frame = parse_frame(data, max_bytes)
-    except FrameError as exc:
-        controller.stop(session, "bad_input")  # zero if this socket was driving; ignored for viewers
-        if exc.close_code is not None:
-            raise
-        return exc.as_frame()
-    try:
-        if isinstance(frame, Drive):
-            controller.drive(session, frame.linear, frame.angular, epoch=frame.epoch, source=frame.source)
-        elif isinstance(frame, Control) and frame.action == "stop":
-            controller.stop(session, "operator")
-        elif frame.action == "takeover":
-            controller.takeover(session)
-        elif frame.action == "release":
-            controller.release(session)
-    except Refused as exc:
-        return exc.as_frame()
-    return None
-
-
 def teleop_socket(ws) -> None:
     teleop = _teleop()
     controller = teleop.controller
-    stopping = current_app.extensions["rover_web"].stopping
     session = controller.connect(_name(request.args.get("name")))
-    try:
-        _send(ws, {**controller.session_state(session, "connected"), "type": "hello", "session": session.id,
-                   "name": session.name, **teleop.hello()})
-        while not stopping.is_set():
-            data = ws.receive(timeout=SOCKET_POLL_S)
-            if data is not None:
-                try:
-                    reply = _handle_frame(controller, session, data, teleop.max_frame_bytes)
-                except FrameError as exc:
-                    controller.disconnect(session)  # zero before the close frame goes out
-                    ws.close(reason=exc.close_code, message=exc.message[:120])
-                    return
-                if reply is not None:
-                    _send(ws, reply)
-            while session.outbox:
-                _send(ws, session.outbox.popleft())
-        ws.close(reason=1001, message="server shutting down")
-    except ConnectionClosed:
-        pass
-    finally:
-        controller.disconnect(session)
+    hello = {**controller.session_state(session, "connected"), "type": "hello", "session": session.id,
+             "name": session.name, **teleop.hello()}
+    TeleopSocket(ws, controller, session, teleop.max_frame_bytes).serve(
+        hello, current_app.extensions["rover_web"].stopping)
 
 
 # --- REST ---
@@ -231,8 +183,9 @@ def init_app(app, rover: Rover) -> None:
     config = rover.config
     ping_s = config["ROVER_WEB_TELEOP_WS_PING_S"]
     # simple_websocket drops an oversized message before buffering it all (close 1009).
+    # InlineFrames: frames are handled in each socket's reader thread (teleop_socket.py).
     app.config["SOCK_SERVER_OPTIONS"] = {"max_message_size": teleop.max_frame_bytes,
-                                         "ping_interval": ping_s or None}
+                                         "ping_interval": ping_s or None, "event_class": InlineFrames}
     sock = Sock(app)
     sock.route("/ws/teleop")(teleop_socket)  # on the app: the module's blueprint is shared by every app
     app.register_blueprint(bp)

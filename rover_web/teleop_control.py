@@ -78,12 +78,14 @@ class Refused(Exception):
 
 @dataclass(eq=False)
 class Session:
-    """One teleop WebSocket. `outbox` holds messages for it; only its own socket thread sends them."""
+    """One teleop WebSocket. `outbox` holds messages for it; only its own socket thread sends them,
+    woken by `wake()` (set by that thread) as soon as one is queued."""
 
     id: str
     name: str
     epoch: int = 0
     outbox: deque = field(default_factory=lambda: deque(maxlen=64))
+    wake: Callable[[], None] | None = None
 
     def public(self) -> dict:
         return {"id": self.id, "name": self.name}
@@ -349,6 +351,8 @@ class TeleopController:
 
     def _tell(self, session: Session, reason: str) -> None:
         session.outbox.append(self._session_message(session, reason))
+        if session.wake is not None:
+            session.wake()
 
     def _session_message(self, session: Session, reason: str) -> dict:
         holder = self._holder

@@ -95,6 +95,14 @@ class TeleopClient:
         with self._cond:
             return [m for m in self.messages if m["type"] == "error" and (code is None or m["error"] == code)]
 
+    def wait_errors(self, count: int, timeout: float = 5.0) -> list[dict]:
+        """Until at least `count` error frames have arrived (replies follow the effect they report:
+        the robot is already at zero when the error frame leaves)."""
+        with self._cond:
+            if not self._cond.wait_for(lambda: len(self.errors()) >= count, timeout):
+                raise TimeoutError(f"{len(self.errors())} error frames, expected {count}")
+        return self.errors()
+
     def wait_closed(self, timeout: float = 5.0) -> int | None:
         assert self.closed.wait(timeout), "the server did not close the socket"
         return self.close_code
