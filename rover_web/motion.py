@@ -24,11 +24,15 @@ class CmdVelOutput:
                  stamped: bool = False, frame_id: str = "base_link"):
         self._runtime = runtime
         self._stamped = stamped
-        self._frame_id = frame_id
         self.max_linear_mps = max_linear_mps
         self.max_angular_rps = max_angular_rps
         msg_type = "geometry_msgs/msg/TwistStamped" if stamped else "geometry_msgs/msg/Twist"
         self._publisher = runtime.publisher(msg_type, topic, qos=10)
+        # One message, refilled under the lock for every publish: publish() copies it out before it
+        # returns, and a fresh Twist is three Python objects to build on the path from a joystick
+        # frame to the wire (bench/teleop.py).
+        self._msg = twist_message(0.0, 0.0, stamped=stamped, frame_id=frame_id)
+        self._twist = self._msg.twist if stamped else self._msg
         self._lock = threading.Lock()
         self._halted = False
         self.last = (0.0, 0.0)
@@ -58,7 +62,9 @@ class CmdVelOutput:
             self._publish(0.0, 0.0)
 
     def _publish(self, linear: float, angular: float) -> None:
-        stamp = self._runtime.now_msg() if self._stamped else None
-        self._publisher.publish(twist_message(linear, angular, stamped=self._stamped, stamp=stamp,
-                                              frame_id=self._frame_id))
+        if self._stamped:
+            self._msg.header.stamp = self._runtime.now_msg()
+        self._twist.linear.x = linear
+        self._twist.angular.z = angular
+        self._publisher.publish(self._msg)
         self.last = (linear, angular)
