@@ -3,8 +3,9 @@
     .venv/bin/python bench/teleop.py [--frames 2000] [--trials 100] [--hold-s 10]
 
 1. frame -> topic: `--frames` joystick frames at 40 Hz, each a new value, from a WebSocket client
-   to the app (`flask run` in its own process); latency is send time to arrival in the subscriber
-   process (both CLOCK_MONOTONIC). Server CPU and RSS over the run.
+   to the app (`flask run` in its own process); latency is the moment the (already framed and
+   masked) frame is written to the socket to its arrival in the subscriber process (both
+   CLOCK_MONOTONIC). Server CPU and RSS over the run.
 2. close -> zero: `--trials` times, drive, then send the WebSocket close frame; time to the zero Twist.
 3. publish-rate jitter: hold one value for `--hold-s` with keep-alives every 100 ms (as the page
    does), so the server's repeater alone sets the rate; intervals between Twists at the subscriber.
@@ -139,11 +140,21 @@ def match_latencies(sub: Subscriber, mark: int, sent: list[float], n: int, scale
     return [first[i] - sent[i] for i in range(n) if i in first]
 
 
+def encoded(text: str) -> bytes:
+    """A masked client text frame, built before the clock starts: a browser frames in native code
+    in microseconds, websocket-client in Python takes ~0.1 ms, which is the client's cost, not the
+    frame's trip to the robot."""
+    import websocket
+
+    return websocket.ABNF.create_frame(text, websocket.ABNF.OPCODE_TEXT).format()
+
+
 def bench_frames(server: Server, sub: Subscriber, n: int) -> None:
     ws = connect(server.url)
     mark = sub.mark()
+    frames = [encoded(frame(value(i, n))) for i in range(n)]
     cpu0, t0 = server.cpu_seconds(), time.monotonic()
-    sent = on_grid(n, RATE_HZ, lambda i: ws.send(frame(value(i, n))))
+    sent = on_grid(n, RATE_HZ, lambda i: ws.sock.sendall(frames[i]))
     cpu1, t1 = server.cpu_seconds(), time.monotonic()
     time.sleep(0.2)
     ws.send(json.dumps({"stop": True}))
