@@ -39,6 +39,8 @@ class EventHub:
         self._seq = 0
         self._latest: dict[str, tuple[int, bytes, Any]] = {}
         self._ring: deque[tuple[int, str, bytes]] = deque(maxlen=ring_size)
+        # The newest change as (seq, channel, frame): a client one change behind takes it as is.
+        self._last_change: tuple[int, str, bytes] = (0, "", b"")
         self._channels: set[str] = set()
         self._clients = 0
         self._max_clients = max_clients
@@ -61,7 +63,9 @@ class EventHub:
         payload = encode(data)
         with self._cond:
             self._seq += 1
-            self._latest[channel] = (self._seq, sse_frame(self._seq, channel, payload), data)
+            frame = sse_frame(self._seq, channel, payload)
+            self._latest[channel] = (self._seq, frame, data)
+            self._last_change = (self._seq, channel, frame)
             self._cond.notify_all()
             self._notify_listeners()
             return self._seq
@@ -102,7 +106,9 @@ class EventHub:
         payload = encode(data)
         with self._cond:
             self._seq += 1
-            self._ring.append((self._seq, channel, sse_frame(self._seq, channel, payload)))
+            frame = sse_frame(self._seq, channel, payload)
+            self._ring.append((self._seq, channel, frame))
+            self._last_change = (self._seq, channel, frame)
             self._cond.notify_all()
             self._notify_listeners()
             return self._seq
@@ -201,6 +207,11 @@ class Subscription:
             cursor = self._cursor
             if hub._seq == cursor:
                 return b""
+            seq, channel, frame = hub._last_change
+            if seq == cursor + 1:
+                # The usual case, one poll per change as it happens: no scan of every channel.
+                self._cursor = seq
+                return frame if channel in self.channels else b""
             frames = [(seq, frame) for ch, (seq, frame, _) in hub._latest.items()
                       if seq > cursor and ch in self.channels]
             for seq, ch, frame in reversed(hub._ring):

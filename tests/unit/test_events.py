@@ -3,6 +3,7 @@ import threading
 import time
 
 import pytest
+from hypothesis import given, settings, strategies as st
 
 from rover_web.events import EventHub, TooManyClients
 
@@ -126,3 +127,45 @@ def test_throttled_publish_limits_rate_and_always_delivers_the_last_value():
         assert [d for _, d, _ in first] == [{"i": 0}]
         later = frames(sub.wait(1.0))
         assert [d for _, d, _ in later] == [{"i": 99}]  # the burst's last value, after the interval
+
+_ops = st.lists(st.tuples(st.sampled_from(["publish", "emit", "poll"]), st.sampled_from(["a", "b", "c"])),
+                max_size=60)
+
+
+@settings(max_examples=200, deadline=None)
+@given(_ops)
+def test_poll_returns_what_changed_since_the_last_poll_whatever_the_polling_pattern(ops):
+    """Against a model: the newest value of each subscribed channel changed since the last poll, and
+    every subscribed ring event since then, in sequence order. One client polls after every change
+    (the broadcaster's fast path), the other only when the operations say so."""
+    hub = EventHub()
+    log = []  # (seq, kind, channel, value)
+    every, sometimes = hub.subscribe(["a", "b"]), hub.subscribe(["a", "b"])
+    every.snapshot(), sometimes.snapshot()
+    cursors = {"every": 0, "sometimes": 0}
+
+    def expected(cursor):
+        latest = {}
+        events = []
+        for seq, kind, channel, value in log:
+            if seq <= cursor or channel not in ("a", "b"):
+                continue
+            if kind == "publish":
+                latest[channel] = (seq, channel, value)
+            else:
+                events.append((seq, channel, value))
+        return sorted([*latest.values(), *events])
+
+    def check(name, sub):
+        got = [(seq, event, data["v"]) for event, data, seq in frames(sub.poll())]
+        assert got == expected(cursors[name])
+        cursors[name] = len(log)
+
+    for i, (op, channel) in enumerate(ops):
+        if op == "poll":
+            check("sometimes", sometimes)
+            continue
+        getattr(hub, op)(channel, {"v": i})
+        log.append((len(log) + 1, op, channel, i))
+        check("every", every)
+    check("sometimes", sometimes)
