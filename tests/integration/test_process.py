@@ -1,5 +1,6 @@
 """The app as an operator runs it: flask run, gunicorn, signals, the reloader, bad settings, no ROS."""
 
+import json
 import os
 import signal
 import subprocess
@@ -102,3 +103,24 @@ def test_missing_ros_exits_with_one_sentence_on_how_to_install(tmp_path):
     last_line = result.stderr.strip().splitlines()[-1]
     assert "pip install -e '.[ros]'" in last_line and "/opt/ros/jazzy/setup.bash" in last_line
     assert "Traceback" not in result.stderr
+
+
+def test_a_served_app_keeps_its_start_up_heap_out_of_the_collector(tmp_path):
+    """A full collection over everything start-up built takes ~20 ms, a pause every thread (a
+    joystick frame, an SSE delivery) waits out; a served app freezes that heap, a test app does not."""
+    script = (
+        "import gc, json\n"
+        "from rover_web import create_app\n"
+        "create_app({'TESTING': True})\n"
+        "testing = gc.get_freeze_count()\n"
+        "create_app()\n"
+        "served = gc.get_freeze_count()\n"
+        "print(json.dumps({'testing': testing, 'served': served, 'objects': len(gc.get_objects())}))\n"
+    )
+    env = subprocess_env(ROVER_WEB_DB_PATH=str(tmp_path / "db.sqlite3"))
+    result = subprocess.run([sys.executable, "-c", script], cwd=ROOT, env=env, capture_output=True, text=True,
+                            timeout=60)
+    assert result.returncode == 0, result.stderr
+    report = json.loads(result.stdout.strip().splitlines()[-1])
+    assert report["testing"] == 0
+    assert report["served"] > 10 * report["objects"]  # nearly everything is frozen, little left to scan
