@@ -1,16 +1,21 @@
 """ROS publish (another process, 100 Hz) -> SSE frame at 1, 10 and 50 clients: latency, server CPU, RSS.
 
     .venv/bin/python bench/events.py [--seconds 10]
+
+Latency runs from the publisher's stamp to "arrived" (the frame in the client's socket, by the
+kernel's receive timestamp) and to "woken" (this one process, which holds every client, woken with
+the socket readable); see common.SseFleet.
 """
 
 from __future__ import annotations
 
 import argparse
+import statistics
 import subprocess
 import sys
 import time
 
-from common import ROOT, Server, SseFleet, machine, ros_env, summary_ms
+from common import ROOT, Server, SseFleet, machine, percentile, ros_env, summary_ms
 
 
 def run(clients: int, seconds: float, env: dict) -> dict:
@@ -22,17 +27,19 @@ def run(clients: int, seconds: float, env: dict) -> dict:
         pub = subprocess.Popen([sys.executable, str(ROOT / "bench" / "odom_publisher.py"), "--rate", "100",
                                 "--count", str(count)], env=env, stdout=subprocess.PIPE, text=True)
         assert pub.stdout.readline().strip() == "publishing"
-        latencies: list[float] = []
+        arrived: list[float] = []
+        woken: list[float] = []
 
-        def on_event(t, name, data):
+        def on_event(t_woken, t_arrived, name, data):
             if name == "odom" and data.get("stamp"):
-                latencies.append(t - data["stamp"])
+                arrived.append(t_arrived - data["stamp"])
+                woken.append(t_woken - data["stamp"])
 
         cpu0, t0 = server.cpu_seconds(), time.monotonic()
         fleet.poll(seconds + 1.0, on_event)
         cpu1, t1 = server.cpu_seconds(), time.monotonic()
         pub.wait(10)
-        return {"clients": clients, "latencies": latencies, "expected": count * clients,
+        return {"clients": clients, "arrived": arrived, "woken": woken, "expected": count * clients,
                 "cpu_pct": 100 * (cpu1 - cpu0) / (t1 - t0), "rss_mb": server.rss_mb()}
     finally:
         fleet.close()
@@ -48,8 +55,10 @@ def main() -> None:
     print(f"# events bench on {machine()}: /odom at 100 Hz from another process -> SSE `odom` frame")
     for n in args.clients:
         r = run(n, args.seconds, env)
-        lat = r["latencies"]
-        print(f"clients {n:3d}: {summary_ms(lat)}  received {len(lat)}/{r['expected']}  "
+        lat = r["arrived"]
+        woken = sorted(r["woken"])
+        print(f"clients {n:3d}: arrived {summary_ms(lat)}  woken p50 {statistics.median(woken) * 1000:.3f} "
+              f"p99 {percentile(woken, 99) * 1000:.3f} ms  received {len(lat)}/{r['expected']}  "
               f"server CPU {r['cpu_pct']:5.1f}% of one core  RSS {r['rss_mb']:.0f} MB", flush=True)
 
 

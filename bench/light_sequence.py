@@ -30,12 +30,13 @@ import os
 import selectors
 import socket
 import statistics
-import struct
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+from common import recv_stamped, stamp_arrivals
 
 ROOT = Path(__file__).resolve().parent.parent
 TOPIC = "/light_sequence"
@@ -96,11 +97,7 @@ class Publisher:
 
 # --- many raw SSE clients on one epoll loop ---
 
-# Linux's SO_TIMESTAMPNS (Python 3.11's socket module lacks the name): each recvmsg() then carries
-# the CLOCK_REALTIME at which the kernel queued the data on this socket.
-SO_TIMESTAMPNS = getattr(socket, "SO_TIMESTAMPNS", 35)
 LIGHT_EVENT = b"event: light_sequence\n"
-REALTIME_MINUS_MONOTONIC = time.time() - time.monotonic()
 
 
 class Stream:
@@ -110,7 +107,7 @@ class Stream:
 
     def __init__(self, port: int, channels: str):
         self.sock = socket.create_connection(("127.0.0.1", port), timeout=10)
-        self.sock.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
+        stamp_arrivals(self.sock)
         self.sock.sendall(f"GET /api/events?channels={channels} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n"
                           "Accept: text/event-stream\r\n\r\n".encode())
         self.sock.setblocking(False)
@@ -126,16 +123,11 @@ class Stream:
 
     def receive(self, t_wake: float) -> None:
         try:
-            data, ancillary, _, _ = self.sock.recvmsg(262144, 64)
+            data, t_arrived = recv_stamped(self.sock, t_wake)
         except BlockingIOError:
             return
         if not data:
             raise RuntimeError("an event stream closed")
-        t_arrived = t_wake
-        for level, kind, value in ancillary:
-            if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS:
-                sec, nsec = struct.unpack("qq", value[:16])
-                t_arrived = sec + nsec * 1e-9 - REALTIME_MINUS_MONOTONIC
         self.chunks.append((t_wake, t_arrived, data))
         window = self._tail + data
         self.light_events_seen += window.count(LIGHT_EVENT)
