@@ -109,7 +109,7 @@ def teleop_socket(ws) -> None:
     hello = {**controller.session_state(session, "connected"), "type": "hello", "session": session.id,
              "name": session.name, **teleop.hello()}
     TeleopSocket(ws, controller, session, teleop.max_frame_bytes).serve(
-        hello, current_app.extensions["rover_web"].stopping)
+        hello, current_app.extensions["rover_web"].stopping, teleop.config["ROVER_WEB_TELEOP_WS_PING_S"] or None)
 
 
 # --- REST ---
@@ -180,12 +180,11 @@ def estop_set():
 def init_app(app, rover: Rover) -> None:
     teleop = Teleop(rover)
     app.extensions["teleop"] = teleop
-    config = rover.config
-    ping_s = config["ROVER_WEB_TELEOP_WS_PING_S"]
     # simple_websocket drops an oversized message before buffering it all (close 1009).
-    # InlineFrames: frames are handled in each socket's reader thread (teleop_socket.py).
-    app.config["SOCK_SERVER_OPTIONS"] = {"max_message_size": teleop.max_frame_bytes,
-                                         "ping_interval": ping_s or None, "event_class": InlineFrames}
+    # InlineFrames: frames are handled in each socket's reader thread (teleop_socket.py), and
+    # TeleopSocket sends the pings itself, so the reader can wait in a plain blocking read.
+    app.config["SOCK_SERVER_OPTIONS"] = {"max_message_size": teleop.max_frame_bytes, "ping_interval": None,
+                                         "event_class": InlineFrames}
     sock = Sock(app)
     sock.route("/ws/teleop")(teleop_socket)  # on the app: the module's blueprint is shared by every app
     app.register_blueprint(bp)

@@ -7,23 +7,33 @@ machine that wake-up is most of the gap between a joystick frame and the Twist o
 `set()`, handles every complete frame at once in the reader thread, so a joystick input is
 published the moment it has been read, and a closed socket stops the robot from the thread that
 saw it close. The request thread keeps what may block or must not interleave: every `send()`
-(hello, state changes, error replies) and the close handshake.
+(hello, state changes, error replies, pings) and the close handshake.
+
+The pings are ours too, sent from the request thread: given `ping_interval`, simple_websocket's
+reader waits in a Python selector loop before every read, which measured 40 µs (median) more per
+frame than its plain blocking read. The rule is the library's: a ping every `ping_s`, and a
+client that has not answered by the next one loses the socket (1008) and control.
 """
 
 from __future__ import annotations
 
 import json
 import logging
+import math
 import threading
+import time
 from typing import Callable
 
 from flask_sock import ConnectionClosed
+from wsproto.events import Ping
+from wsproto.utilities import LocalProtocolError
 
 from .teleop_control import Refused, Session, TeleopController
 from .teleop_protocol import Control, Drive, FrameError, parse_frame
 
 log = logging.getLogger(__name__)
 
+CLOSE_POLICY_VIOLATION = 1008
 CLOSE_INTERNAL_ERROR = 1011
 # How often the request thread, with nothing to send, checks for shutdown.
 POLL_S = 0.05
@@ -103,14 +113,15 @@ class TeleopSocket:
         self._close: tuple[int, str] | None = None  # set by the reader thread, carried out by ours
         session.wake = self.events.wake
 
-    def serve(self, hello: dict, stopping: threading.Event) -> None:
+    def serve(self, hello: dict, stopping: threading.Event, ping_s: float | None = None) -> None:
         """Runs in the request thread until the socket ends or the server stops."""
         ws, session = self.ws, self.session
+        next_ping = time.monotonic() + ping_s if ping_s else math.inf
         try:
             send(ws, hello)
             self.events.attach(self._on_reader_event)
             while not stopping.is_set():
-                self.events.wait(POLL_S)
+                self.events.wait(max(0.0, min(POLL_S, next_ping - time.monotonic())))
                 self.events.clear()
                 while session.outbox:
                     send(ws, session.outbox.popleft())
@@ -119,11 +130,28 @@ class TeleopSocket:
                     return
                 if not ws.connected:
                     return
+                if time.monotonic() >= next_ping:
+                    if not ws.pong_received:
+                        self.controller.disconnect(session)  # zero before the close frame goes out
+                        ws.close(reason=CLOSE_POLICY_VIOLATION, message="Ping/Pong timeout")
+                        return
+                    self._ping()
+                    next_ping = time.monotonic() + ping_s
             ws.close(reason=1001, message="server shutting down")
         except ConnectionClosed:
             pass
         finally:
             self.controller.disconnect(session)
+
+    def _ping(self) -> None:
+        """What simple_websocket's reader does when it pings, done here so the reader never has to
+        time anything; the reader still records the pong (`pong_received`)."""
+        ws = self.ws
+        ws.pong_received = False
+        try:
+            ws.sock.send(ws.ws.send(Ping()))
+        except (OSError, LocalProtocolError):
+            raise ConnectionClosed(ws.close_reason, ws.close_message) from None
 
     def _on_reader_event(self) -> None:
         """In the reader thread: a frame arrived, or the connection ended. Must never raise: an
