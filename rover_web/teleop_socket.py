@@ -20,6 +20,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import socket
 import threading
 import time
 from typing import Callable
@@ -37,6 +38,8 @@ CLOSE_POLICY_VIOLATION = 1008
 CLOSE_INTERNAL_ERROR = 1011
 # How often the request thread, with nothing to send, checks for shutdown.
 POLL_S = 0.05
+# How long a client has to answer our close frame before the connection is cut.
+CLOSE_GRACE_S = 0.5
 
 
 class InlineFrames:
@@ -126,22 +129,38 @@ class TeleopSocket:
                 while session.outbox:
                     send(ws, session.outbox.popleft())
                 if self._close is not None:
-                    ws.close(reason=self._close[0], message=self._close[1])
+                    self._hang_up(*self._close)
                     return
                 if not ws.connected:
                     return
                 if time.monotonic() >= next_ping:
                     if not ws.pong_received:
                         self.controller.disconnect(session)  # zero before the close frame goes out
-                        ws.close(reason=CLOSE_POLICY_VIOLATION, message="Ping/Pong timeout")
+                        self._hang_up(CLOSE_POLICY_VIOLATION, "Ping/Pong timeout")
                         return
                     self._ping()
                     next_ping = time.monotonic() + ping_s
-            ws.close(reason=1001, message="server shutting down")
+            self._hang_up(1001, "server shutting down")
         except ConnectionClosed:
             pass
         finally:
             self.controller.disconnect(session)
+
+    def _hang_up(self, code: int, message: str) -> None:
+        """Send our close frame, give the client CLOSE_GRACE_S to answer it (its answer ends the
+        reader thread), then cut the connection: the reader waits in a blocking read, and a client
+        that is gone or ignores the close must not keep it, and the socket, forever."""
+        ws = self.ws
+        ws.close(reason=code, message=message)
+        reader = getattr(ws, "thread", None)
+        if reader is not None and reader is not threading.current_thread():
+            reader.join(CLOSE_GRACE_S)
+            if not reader.is_alive():
+                return
+        try:
+            ws.sock.shutdown(socket.SHUT_RDWR)
+        except OSError:
+            pass  # already gone
 
     def _ping(self) -> None:
         """What simple_websocket's reader does when it pings, done here so the reader never has to

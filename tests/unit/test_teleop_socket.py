@@ -25,10 +25,21 @@ class Output:
         self.sent.append((0.0, 0.0))
 
 
+class Socket:
+    def __init__(self):
+        self.shut_down = False
+
+    def shutdown(self, how):
+        self.shut_down = True
+
+
 class Connection:
-    """The attributes of simple_websocket.Server that TeleopSocket uses."""
+    """The attributes of simple_websocket.Server that TeleopSocket uses (no reader thread: the
+    test is the reader)."""
 
     def __init__(self):
+        self.sock = Socket()
+        self.thread = None
         self.event = InlineFrames()
         self.input_buffer = []
         self.connected = True
@@ -103,6 +114,7 @@ def test_invalid_payload_stops_the_robot_then_closes_and_ignores_the_rest(rig):
     ws.arrive("{not json", {"linear": 1.0, "angular": 0.0})
     thread.join(5)
     assert ws.closed_with[0] == 1007
+    assert ws.sock.shut_down  # no reader to answer the close: the connection is cut
     assert out.sent == [(2.5, 0.0), (0.0, 0.0)]  # the zero came before the close; the later frame never ran
     assert controller.state()["holder"] is None
 
