@@ -115,19 +115,13 @@ class MjpegClient:
         self._thread.join(2)
 
 
-class _Reader:
-    """Buffered reads from a socket: lines and exact byte counts; None at end of stream."""
+class _Buffered:
+    """Lines and exact byte counts out of `buf`, which `_fill()` tops up; None at end of stream."""
 
-    def __init__(self, sock: socket.socket):
-        self.sock = sock
-        self.buf = bytearray()
+    buf: bytearray
 
     def _fill(self) -> bool:
-        data = self.sock.recv(262144)
-        if not data:
-            return False
-        self.buf += data
-        return True
+        raise NotImplementedError
 
     def line(self) -> str | None:
         while True:
@@ -148,7 +142,22 @@ class _Reader:
         return data
 
 
-class _Body:
+class _Reader(_Buffered):
+    """Buffered reads from a socket."""
+
+    def __init__(self, sock: socket.socket):
+        self.sock = sock
+        self.buf = bytearray()
+
+    def _fill(self) -> bool:
+        data = self.sock.recv(262144)
+        if not data:
+            return False
+        self.buf += data
+        return True
+
+
+class _Body(_Buffered):
     """The response body, de-chunked when the server chunks it (Werkzeug does for streams)."""
 
     def __init__(self, reader: _Reader, chunked: bool, length: int | None):
@@ -180,24 +189,6 @@ class _Body:
             return False
         self.buf += data[:-2]
         return True
-
-    def line(self) -> str | None:
-        while True:
-            end = self.buf.find(b"\r\n")
-            if end >= 0:
-                text = bytes(self.buf[:end]).decode("latin-1")
-                del self.buf[:end + 2]
-                return text
-            if not self._fill():
-                return None
-
-    def read(self, n: int) -> bytes | None:
-        while len(self.buf) < n:
-            if not self._fill():
-                return None
-        data = bytes(self.buf[:n])
-        del self.buf[:n]
-        return data
 
     def read_all(self) -> bytes:
         while self._fill():
