@@ -11,6 +11,7 @@ from PIL import Image
 
 from tests.camera_peer import ImagePublisher
 from tests.mjpeg import MjpegClient
+from tests.waiting import wait_until
 
 IMAGE = "sensor_msgs/msg/Image"
 COMPRESSED = "sensor_msgs/msg/CompressedImage"
@@ -42,17 +43,6 @@ def mjpeg_client():
     yield make
     for client in made:
         client.close()
-
-
-def wait_until(predicate, timeout=10.0, what="condition"):
-    deadline = time.monotonic() + timeout
-    while True:
-        value = predicate()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"{what} not reached within {timeout} s")
-        time.sleep(0.05)
 
 
 def wait_listed(server, topic, timeout=15.0):

@@ -12,6 +12,7 @@ import requests
 from PIL import Image
 
 from tests.rospeer import ROOT, subprocess_env
+from tests.waiting import wait_until
 
 pytestmark = pytest.mark.ros
 
@@ -28,17 +29,6 @@ def amcl(x, y, yaw=0.0, frame="map"):
     return {"header": {"frame_id": frame},
             "pose": {"pose": {"position": {"x": x, "y": y},
                               "orientation": {"z": math.sin(yaw / 2), "w": math.cos(yaw / 2)}}}}
-
-
-def wait_until(predicate, timeout=10.0, interval=0.05, what="condition"):
-    deadline = time.monotonic() + timeout
-    while True:
-        value = predicate()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"{what} not met within {timeout} s")
-        time.sleep(interval)
 
 
 def map_state(url, name=B, cm_per_pixel=None):

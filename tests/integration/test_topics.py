@@ -8,7 +8,7 @@ import requests
 
 from tests.camera_peer import ImagePublisher
 
-from .test_camera import wait_until
+from tests.waiting import wait_until
 
 TWIST = "geometry_msgs/msg/Twist"
 
