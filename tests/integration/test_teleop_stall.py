@@ -18,6 +18,7 @@ import time
 import pytest
 
 from tests.teleop_support import StallingProxy, TeleopClient, drive_at, is_zero, subscribe_cmd_vel, twists, warm_up
+from tests.waiting import wait_until
 
 BURST_VALUE = 0.8   # what the operator "held" during the stall: 4.0 m/s must never appear
 BURST_FRAMES = 40   # one second at 40 Hz
@@ -73,6 +74,20 @@ def test_network_stall_then_burst(live_server, ros_peer):
         proxy.close()
 
 
+def freeze(pid: int) -> None:
+    """SIGSTOP, returning once every thread has stopped: kill() returns before they have, and a
+    frame sent in that gap is read by a live server, rightly, as a live operator's."""
+    os.kill(pid, signal.SIGSTOP)
+
+    def stopped(tid: str) -> bool:
+        try:
+            with open(f"/proc/{pid}/task/{tid}/stat") as f:
+                return f.read().rsplit(")", 1)[1].split()[0] in ("T", "t")
+        except FileNotFoundError:
+            return True  # a thread that ended cannot run
+    wait_until(lambda: all(stopped(tid) for tid in os.listdir(f"/proc/{pid}/task")), 5, "server frozen", 0.001)
+
+
 def test_server_stall_then_burst(server_process, ros_peer):
     server = server_process().start()
     peer = ros_peer()
@@ -82,7 +97,7 @@ def test_server_stall_then_burst(server_process, ros_peer):
     pid = server.proc.pid
     try:
         t_stall, t_unstall, zero_t = drive_then_check_burst_was_refused(
-            client, peer, lambda: os.kill(pid, signal.SIGSTOP), lambda: os.kill(pid, signal.SIGCONT))
+            client, peer, lambda: freeze(pid), lambda: os.kill(pid, signal.SIGCONT))
         # A frozen server cannot publish: the stop came on waking, before it judged any queued frame.
         assert zero_t > t_unstall
     finally:
