@@ -23,7 +23,7 @@ from .config import ConfigError
 from .core import Rover
 from .http import ApiError, json_body
 from .teleop_control import REST_COMMANDS, Limits, Refused, Repeater, TeleopController
-from .teleop_socket import InlineFrames, TeleopSocket
+from .teleop_socket import FrameReader, TeleopSocket
 from .teleop_store import EStopStore
 from .validate import InvalidInput, number, only_keys, text
 
@@ -105,11 +105,22 @@ def _name(raw: str | None) -> str | None:
 def teleop_socket(ws) -> None:
     teleop = _teleop()
     controller = teleop.controller
-    session = controller.connect(_name(request.args.get("name")))
-    hello = {**controller.session_state(session, "connected"), "type": "hello", "session": session.id,
-             "name": session.name, **teleop.hello()}
-    TeleopSocket(ws, controller, session, teleop.max_frame_bytes).serve(
-        hello, current_app.extensions["rover_web"].stopping, teleop.config["ROVER_WEB_TELEOP_WS_PING_S"] or None)
+    try:
+        session = controller.connect(_name(request.args.get("name")))
+        hello = {**controller.session_state(session, "connected"), "type": "hello", "session": session.id,
+                 "name": session.name, **teleop.hello()}
+        TeleopSocket(ws, controller, session, teleop.max_frame_bytes).serve(
+            hello, current_app.extensions["rover_web"].stopping, teleop.config["ROVER_WEB_TELEOP_WS_PING_S"] or None)
+    finally:
+        ws.thread.attach(None)  # a reader that never got a TeleopSocket ends rather than wait forever
+
+
+def _offer_no_extensions() -> None:
+    """Before the handshake: agree to no extension. Teleop frames are ~50 bytes, so
+    permessage-deflate would save nothing and cost zlib work on every frame at both ends; our
+    reader (ws_frames.py) reads plain frames and refuses compressed ones (1002)."""
+    if request.endpoint == "teleop_socket":
+        request.environ.pop("HTTP_SEC_WEBSOCKET_EXTENSIONS", None)
 
 
 # --- REST ---
@@ -180,11 +191,10 @@ def estop_set():
 def init_app(app, rover: Rover) -> None:
     teleop = Teleop(rover)
     app.extensions["teleop"] = teleop
-    # simple_websocket drops an oversized message before buffering it all (close 1009).
-    # InlineFrames: frames are handled in each socket's reader thread (teleop_socket.py), and
-    # TeleopSocket sends the pings itself, so the reader can wait in a plain blocking read.
-    app.config["SOCK_SERVER_OPTIONS"] = {"max_message_size": teleop.max_frame_bytes, "ping_interval": None,
-                                         "event_class": InlineFrames}
+    # FrameReader: simple_websocket does the handshake, then our reader thread reads the frames
+    # (teleop_socket.py, ws_frames.py); TeleopSocket sends the pings.
+    app.config["SOCK_SERVER_OPTIONS"] = {"ping_interval": None, "thread_class": FrameReader}
+    app.before_request(_offer_no_extensions)
     sock = Sock(app)
     sock.route("/ws/teleop")(teleop_socket)  # on the app: the module's blueprint is shared by every app
     app.register_blueprint(bp)

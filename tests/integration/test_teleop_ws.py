@@ -1,6 +1,7 @@
 """The joystick WebSocket against a real rclpy subscriber in another process."""
 
 import math
+import sys
 import time
 
 import pytest
@@ -174,3 +175,28 @@ def test_twist_stamped_option(rig):
     assert before - 1 <= stamp <= time.time() + 1  # the server's clock
     client.close()
     peer.wait_for("/cmd_vel", lambda m: is_zero(m), timeout=1.0)
+
+
+@pytest.mark.parametrize("how", ["flask", "gunicorn"])
+def test_the_socket_drives_and_stops_under_flask_run_and_gunicorn_and_agrees_no_compression(
+        how, server_process, ros_peer):
+    """Both ways README runs the app hand the socket over differently (flask-sock's Werkzeug and
+    gunicorn modes). A browser offers permessage-deflate; the server declines it, so frames stay
+    plain, as FrameReader requires."""
+    from tests.conftest import free_port
+
+    port = free_port()
+    args = [sys.executable, "-m", "gunicorn", "-c", "gunicorn.conf.py", "rover_web:create_app()"] \
+        if how == "gunicorn" else None
+    server = server_process(port=port, env={"ROVER_WEB_PORT": str(port)}, args=args).start()
+    peer = ros_peer()
+    subscribe_cmd_vel(peer)
+    warm_up(peer, server.url)
+    client = TeleopClient(server.url, header=["Sec-WebSocket-Extensions: permessage-deflate; client_max_window_bits"])
+    assert "sec-websocket-extensions" not in {k.lower() for k in client.ws.getheaders()}
+    client.drive(0.5, 0.0)
+    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == 2.5, timeout=2.0)
+    client.send_close()
+    assert client.wait_closed() == 1000  # the close handshake completes
+    peer.wait_for("/cmd_vel", is_zero, timeout=1.0)
+    assert "Traceback" not in server.log(), server.log()
