@@ -16,7 +16,7 @@ connection stays open. Either way the caller stops the robot if this socket was 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 from .teleop_control import SOURCES
 from .validate import InvalidInput, loads_strict, number, only_keys, text
@@ -37,16 +37,14 @@ class FrameError(Exception):
         return {"type": "error", "error": self.code, "message": self.message, "status": 400}
 
 
-@dataclass(frozen=True)
-class Drive:
+class Drive(NamedTuple):  # a tuple: built 40 times a second, and cheaper than a frozen dataclass
     linear: float
     angular: float
     epoch: int = 0
     source: str = "joystick"
 
 
-@dataclass(frozen=True)
-class Control:
+class Control(NamedTuple):
     action: str  # stop | takeover | release
 
 
@@ -59,7 +57,9 @@ def parse_frame(data: str | bytes, max_bytes: int) -> Drive | Control:
         if len(data) > max_bytes:
             raise FrameError("frame_too_large", f"frames are limited to {max_bytes} bytes", CLOSE_MESSAGE_TOO_BIG)
         raise FrameError("binary_frame", "send JSON text frames, not binary", CLOSE_UNSUPPORTED_DATA)
-    if len(data) > max_bytes or len(data.encode("utf-8", "surrogatepass")) > max_bytes:
+    # A character is at most 4 bytes in UTF-8: most frames need no encoding to be measured.
+    if len(data) > max_bytes or (4 * len(data) > max_bytes
+                                 and len(data.encode("utf-8", "surrogatepass")) > max_bytes):
         raise FrameError("frame_too_large", f"frames are limited to {max_bytes} bytes", CLOSE_MESSAGE_TOO_BIG)
     try:
         obj = loads_strict(data)
