@@ -35,7 +35,9 @@ class TooManyClients(RuntimeError):
 
 class EventHub:
     def __init__(self, ring_size: int = 256, max_clients: int = 256):
-        self._cond = threading.Condition()
+        self._lock = threading.RLock()  # publish() re-enters it from publish_throttled and the flusher
+        self._cond = threading.Condition(self._lock)  # subscribers wait on this one
+        self._held = threading.Condition(self._lock)  # and only the flusher on this one
         self._seq = 0
         self._latest: dict[str, tuple[int, bytes, Any]] = {}
         self._ring: deque[tuple[int, str, bytes]] = deque(maxlen=ring_size)
@@ -45,7 +47,9 @@ class EventHub:
         self._clients = 0
         self._max_clients = max_clients
         self._closed = False
-        self._throttle: dict[str, list] = {}  # channel -> [last publish time, pending value, timer]
+        self._throttle: dict[str, list] = {}  # channel -> [last publish time, held value or None]
+        self._held_due: dict[str, float] = {}  # channel -> when its held value goes out
+        self._flusher: threading.Thread | None = None
         self._listeners: list = []
 
     # --- producers ---
@@ -73,33 +77,52 @@ class EventHub:
     def publish_throttled(self, channel: str, data: Any, max_hz: float) -> None:
         """Publish at most max_hz times a second, and always the latest value in the end.
 
-        Values that arrive too soon are held, and a timer sends the newest one when the interval is
-        up, so a robot that stops is shown stopped even when its final message came in a burst.
+        Values that arrive too soon are held, and the hub's one flusher thread sends the newest
+        when the interval is up, so a robot that stops is shown stopped even when its final message
+        came in a burst. (One thread for every channel: a timer thread per held value meant
+        starting ~20 threads a second for each fast topic, on the joystick's path among others.)
         """
         interval = 1.0 / max_hz
-        with self._cond:  # an RLock: publish() below re-enters it, keeping values in order
-            state = self._throttle.setdefault(channel, [-math.inf, None, None])
+        with self._lock:
+            state = self._throttle.setdefault(channel, [-math.inf, None])
             now = time.monotonic()
-            wait = state[0] + interval - now
-            if wait > 0:
+            due = state[0] + interval
+            if due > now:
+                if state[1] is None:
+                    self._held_due[channel] = due
+                    self._wake_flusher()
                 state[1] = (data,)
-                if state[2] is None:
-                    state[2] = threading.Timer(wait, self._flush_throttled, args=(channel,))
-                    state[2].daemon = True
-                    state[2].start()
                 return
             state[0] = now
-            state[1] = None  # anything held is older than this value; a late timer must not resend it
+            state[1] = None  # anything held is older than this value: it must not go out after it
+            self._held_due.pop(channel, None)
             self.publish(channel, data)
 
-    def _flush_throttled(self, channel: str) -> None:
-        with self._cond:
-            state = self._throttle[channel]
-            pending, state[1], state[2] = state[1], None, None
-            if pending is None or self._closed:
-                return
-            state[0] = time.monotonic()
-            self.publish(channel, pending[0])
+    def _wake_flusher(self) -> None:
+        if self._flusher is None:
+            self._flusher = threading.Thread(target=self._flush_held, name="event-hub-flusher", daemon=True)
+            self._flusher.start()
+        else:
+            self._held.notify()
+
+    def _flush_held(self) -> None:
+        """Sends each held value when its channel's interval is up; ends with the hub."""
+        with self._lock:
+            while not self._closed:
+                if not self._held_due:
+                    self._held.wait()
+                    continue
+                channel = min(self._held_due, key=self._held_due.__getitem__)
+                wait = self._held_due[channel] - time.monotonic()
+                if wait > 0:
+                    self._held.wait(wait)
+                    continue
+                del self._held_due[channel]
+                state = self._throttle[channel]
+                held, state[1] = state[1], None
+                if held is not None:
+                    state[0] = time.monotonic()
+                    self.publish(channel, held[0])
 
     def emit(self, channel: str, data: Any) -> int:
         """An event that must reach every client in order (not conflated), kept in the ring."""
@@ -132,6 +155,7 @@ class EventHub:
         with self._cond:
             self._closed = True
             self._cond.notify_all()
+            self._held.notify()
             self._notify_listeners()
 
     # --- consumers ---

@@ -128,6 +128,43 @@ def test_throttled_publish_limits_rate_and_always_delivers_the_last_value():
         later = frames(sub.wait(1.0))
         assert [d for _, d, _ in later] == [{"i": 99}]  # the burst's last value, after the interval
 
+def test_held_values_of_every_channel_go_out_from_one_thread_that_ends_with_the_hub():
+    hub = EventHub()
+    channels = [f"c{i}" for i in range(10)]
+    before = threading.active_count()
+    with hub.subscribe(channels) as sub:
+        sub.snapshot()
+        for burst in range(3):
+            for channel in channels:
+                for i in range(5):
+                    hub.publish_throttled(channel, {"burst": burst, "i": i}, max_hz=50)
+            assert threading.active_count() <= before + 1  # one flusher, not a timer per held value
+        got = {}
+        deadline = time.monotonic() + 5
+        while len(got) < len(channels) or any(v != {"burst": 2, "i": 4} for v in got.values()):
+            assert time.monotonic() < deadline, got
+            for channel, data, _ in frames(sub.wait(0.5)):
+                got[channel] = data
+    flusher = hub._flusher
+    hub.close()
+    flusher.join(2)
+    assert not flusher.is_alive()
+
+
+def test_a_value_that_goes_out_directly_drops_the_older_held_one():
+    hub = EventHub()
+    with hub.subscribe(["odom"]) as sub:
+        sub.snapshot()
+        hub.publish_throttled("odom", {"i": 0}, max_hz=10)
+        assert [d for _, d, _ in frames(sub.wait(0.01))] == [{"i": 0}]
+        hub.publish_throttled("odom", {"i": 1}, max_hz=10)  # held until 0.1 s after the first
+        time.sleep(0.01)
+        hub.publish_throttled("odom", {"i": 2}, max_hz=1000)  # its own interval is up: out at once
+        assert [d for _, d, _ in frames(sub.wait(0.01))] == [{"i": 2}]
+        assert sub.wait(0.2) == b""  # past the held value's time, and it never came
+    hub.close()
+
+
 _ops = st.lists(st.tuples(st.sampled_from(["publish", "emit", "poll"]), st.sampled_from(["a", "b", "c"])),
                 max_size=60)
 
