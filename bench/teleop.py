@@ -1,16 +1,19 @@
 """Teleop: WebSocket frame -> Twist on /cmd_vel in a separate rclpy process; close -> zero; rate jitter.
 
-    .venv/bin/python bench/teleop.py [--frames 2000] [--trials 100] [--hold-s 10]
+    .venv/bin/python bench/teleop.py [--frames 2000] [--block 250] [--trials 100] [--hold-s 10]
 
 1. frame -> topic: `--frames` joystick frames at 40 Hz, each a new value, from a WebSocket client
    to the app (`flask run` in its own process); latency is the moment the (already framed and
    masked) frame is written to the socket to its arrival in the subscriber process (both
-   CLOCK_MONOTONIC). Server CPU and RSS over the run.
+   CLOCK_MONOTONIC). Server CPU and RSS over the run. In blocks of `--block` frames that
+   alternate with the baseline's (4.), so both are measured in the same minutes: on a shared
+   virtual machine rclpy -> rclpy alone drifts by a tenth of a millisecond from minute to minute.
 2. close -> zero: `--trials` times, drive, then send the WebSocket close frame; time to the zero Twist.
 3. publish-rate jitter: hold one value for `--hold-s` with keep-alives every 100 ms (as the page
    does), so the server's repeater alone sets the rate; intervals between Twists at the subscriber.
 4. baseline: the same number of Twists at 40 Hz from a plain rclpy publisher in this process to
-   the same subscriber, measured the same way (what rclpy -> rclpy costs on this machine).
+   a subscriber process of the same kind, measured the same way (what rclpy -> rclpy costs on this
+   machine), in the blocks between the app's. The app's own share is printed as the difference.
 """
 
 from __future__ import annotations
@@ -131,13 +134,18 @@ def value(i: int, n: int) -> float:
     return round((i % n + 1) / (n + 1), 6)
 
 
-def match_latencies(sub: Subscriber, mark: int, sent: list[float], n: int, scale: float) -> list[float]:
+def match_latencies(sub: Subscriber, mark: int, sent: dict[int, float], n: int, scale: float) -> list[float]:
+    """Latency of each frame index in `sent` (index -> send time), from the first Twist carrying its value."""
     first: dict[int, float] = {}
     for t, lin, _ in sub.since(mark):
         i = round(lin / scale * (n + 1)) - 1
-        if 0 <= i < n and i not in first:
+        if i in sent and i not in first:
             first[i] = t
-    return [first[i] - sent[i] for i in range(n) if i in first]
+    return [first[i] - t_sent for i, t_sent in sent.items() if i in first]
+
+
+def blocks(n: int, size: int) -> list[range]:
+    return [range(start, min(n, start + size)) for start in range(0, n, size)]
 
 
 def encoded(text: str) -> bytes:
@@ -149,19 +157,29 @@ def encoded(text: str) -> bytes:
     return websocket.ABNF.create_frame(text, websocket.ABNF.OPCODE_TEXT).format()
 
 
-def bench_frames(server: Server, sub: Subscriber, n: int) -> None:
+def bench_frames(server: Server, sub: Subscriber, baseline: Baseline | None, n: int, block: int) -> None:
     ws = connect(server.url)
-    mark = sub.mark()
     frames = [encoded(frame(value(i, n))) for i in range(n)]
-    cpu0, t0 = server.cpu_seconds(), time.monotonic()
-    sent = on_grid(n, RATE_HZ, lambda i: ws.sock.sendall(frames[i]))
-    cpu1, t1 = server.cpu_seconds(), time.monotonic()
-    time.sleep(0.2)
-    ws.send(json.dumps({"stop": True}))
-    latencies = match_latencies(sub, mark, sent, n, MAX_LINEAR)
-    print(f"frame -> /cmd_vel at 40 Hz: {summary_ms(latencies)}  received {len(latencies)}/{n}  "
-          f"server CPU {100 * (cpu1 - cpu0) / (t1 - t0):.1f}% of one core  RSS {server.rss_mb():.0f} MB",
-          flush=True)
+    app, base = [], []
+    cpu_s = run_s = 0.0
+    for indices in blocks(n, block):
+        mark = sub.mark()
+        cpu0, t0 = server.cpu_seconds(), time.monotonic()
+        times = on_grid(len(indices), RATE_HZ, lambda k: ws.sock.sendall(frames[indices[k]]))
+        cpu_s, run_s = cpu_s + server.cpu_seconds() - cpu0, run_s + time.monotonic() - t0
+        time.sleep(0.2)
+        ws.send(json.dumps({"stop": True}))  # the operator's stop: no deadman, so no new epoch
+        app += match_latencies(sub, mark, dict(zip(indices, times)), n, MAX_LINEAR)
+        if baseline is not None:
+            base += baseline.run(indices, n)
+    print(f"frame -> /cmd_vel at 40 Hz: {summary_ms(app)}  received {len(app)}/{n}  "
+          f"server CPU {100 * cpu_s / run_s:.1f}% of one core  RSS {server.rss_mb():.0f} MB", flush=True)
+    if baseline is not None:
+        print(f"baseline rclpy -> rclpy:    {summary_ms(base)}  received {len(base)}/{n}  "
+              f"(blocks of {block}, alternating with the app's)", flush=True)
+        ms = [sorted(x * 1000 for x in lat) for lat in (app, base)]
+        print(f"the app's share:            median {statistics.median(ms[0]) - statistics.median(ms[1]):6.3f} ms  "
+              f"p99 {percentile(ms[0], 99) - percentile(ms[1], 99):6.3f} ms  (app minus baseline)", flush=True)
     hang_up(ws)
 
 
@@ -201,47 +219,54 @@ def bench_rate(server: Server, sub: Subscriber, hold_s: float) -> None:
     hang_up(ws)
 
 
-def bench_baseline(sub_env: dict, n: int) -> None:
-    """Plain rclpy publisher -> the same subscriber process, same grid, same matching."""
-    import rclpy
-    from geometry_msgs.msg import Twist
-    from rclpy.context import Context
-    from rclpy.signals import SignalHandlerOptions
+class Baseline:
+    """A plain rclpy publisher in this process and its own subscriber process on /bench_baseline."""
 
-    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-    context = Context()
-    rclpy.init(context=context, domain_id=int(sub_env["ROS_DOMAIN_ID"]), signal_handler_options=SignalHandlerOptions.NO)
-    node = rclpy.create_node("bench_baseline_publisher", context=context)
-    pub = node.create_publisher(Twist, "/bench_baseline", 10)
-    sub = Subscriber(sub_env, "/bench_baseline")  # ready once it sees this publisher
-    try:
+    def __init__(self, sub_env: dict):
+        import rclpy
+        from geometry_msgs.msg import Twist
+        from rclpy.context import Context
+        from rclpy.signals import SignalHandlerOptions
+
+        os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+        self._twist = Twist
+        self.context = Context()
+        rclpy.init(context=self.context, domain_id=int(sub_env["ROS_DOMAIN_ID"]),
+                   signal_handler_options=SignalHandlerOptions.NO)
+        self.node = rclpy.create_node("bench_baseline_publisher", context=self.context)
+        self.pub = self.node.create_publisher(Twist, "/bench_baseline", 10)
+        self.sub = Subscriber(sub_env, "/bench_baseline")  # ready once it sees this publisher
         deadline = time.monotonic() + 10
-        while pub.get_subscription_count() == 0 and time.monotonic() < deadline:
+        while self.pub.get_subscription_count() == 0 and time.monotonic() < deadline:
             time.sleep(0.01)
         for _ in range(20):  # warm up discovery both ways
-            pub.publish(Twist())
+            self.pub.publish(Twist())
             time.sleep(0.02)
         time.sleep(0.3)
-        mark = sub.mark()
 
-        def send(i: int) -> None:
-            msg = Twist()
-            msg.linear.x = value(i, n) * MAX_LINEAR
-            pub.publish(msg)
+    def run(self, indices: range, n: int) -> list[float]:
+        """Frames `indices` of `n` at 40 Hz, as the app's were; their latencies."""
+        mark = self.sub.mark()
 
-        sent = on_grid(n, RATE_HZ, send)
-        time.sleep(0.3)
-        latencies = match_latencies(sub, mark, sent, n, MAX_LINEAR)
-        print(f"baseline rclpy -> rclpy:    {summary_ms(latencies)}  received {len(latencies)}/{n}", flush=True)
-    finally:
-        sub.stop()
-        node.destroy_node()
-        context.try_shutdown()
+        def send(k: int) -> None:
+            msg = self._twist()
+            msg.linear.x = value(indices[k], n) * MAX_LINEAR
+            self.pub.publish(msg)
+
+        times = on_grid(len(indices), RATE_HZ, send)
+        time.sleep(0.2)
+        return match_latencies(self.sub, mark, dict(zip(indices, times)), n, MAX_LINEAR)
+
+    def close(self) -> None:
+        self.sub.stop()
+        self.node.destroy_node()
+        self.context.try_shutdown()
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--frames", type=int, default=2000)
+    parser.add_argument("--block", type=int, default=250, help="frames per block; app and baseline alternate")
     parser.add_argument("--trials", type=int, default=100)
     parser.add_argument("--hold-s", type=float, default=10.0)
     parser.add_argument("--no-baseline", action="store_true")
@@ -252,7 +277,7 @@ def main() -> None:
     print(f"# teleop bench on {machine()}: app in its own process, subscriber in another "
           f"(ROS domain {env['ROS_DOMAIN_ID']})", flush=True)
     server = Server(env)
-    sub = None
+    sub = baseline = None
     try:
         sub = Subscriber(env)
         deadline = time.monotonic() + 10
@@ -262,15 +287,16 @@ def main() -> None:
                 raise RuntimeError("the subscriber never heard the app")
             requests.post(server.url + "/api/teleop", json={"command": "stop"}, timeout=5)
             time.sleep(0.05)
-        bench_frames(server, sub, args.frames)
+        baseline = None if args.no_baseline else Baseline(env)
+        bench_frames(server, sub, baseline, args.frames, args.block)
         bench_close(server, sub, args.trials)
         bench_rate(server, sub, args.hold_s)
     finally:
+        if baseline:
+            baseline.close()
         if sub:
             sub.stop()
         server.stop()
-    if not args.no_baseline:
-        bench_baseline(env, args.frames)
     scratch.cleanup()
 
 
