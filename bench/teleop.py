@@ -10,7 +10,8 @@
    virtual machine rclpy -> rclpy alone drifts by a tenth of a millisecond from minute to minute.
 2. close -> zero: `--trials` times, drive, then send the WebSocket close frame; time to the zero Twist.
 3. publish-rate jitter: hold one value for `--hold-s` with keep-alives every 100 ms (as the page
-   does), so the server's repeater alone sets the rate; intervals between Twists at the subscriber.
+   does), so the server's repeater alone sets the rate; intervals between its Twists at the
+   subscriber, from the first repeat on.
 4. baseline: the same number of Twists at 40 Hz from a plain rclpy publisher in this process to
    a subscriber process of the same kind, measured the same way (what rclpy -> rclpy costs on this
    machine), in the blocks between the app's. The app's own share is printed as the difference.
@@ -83,18 +84,40 @@ class Subscriber:
             self.proc.kill()
 
 
+class Heard:
+    """What the server said on a bench socket: its current epoch, and how often it stopped or refused."""
+
+    def __init__(self, epoch: int):
+        self.epoch = epoch
+        self.counts: dict[str, int] = {}
+
+    def note(self, message: dict) -> None:
+        if "epoch" in message:
+            self.epoch = message["epoch"]
+        key = message.get("error") if message.get("type") == "error" else message.get("reason")
+        if key in ("deadman", "stale_epoch", "not_in_control", "estop_engaged", "bad_input"):
+            self.counts[key] = self.counts.get(key, 0) + 1
+
+
 def connect(url: str):
-    """A WebSocket that, like a browser, keeps reading (which answers the server's pings)."""
+    """A WebSocket that, like a browser, keeps reading (which answers the server's pings) and
+    follows the epoch, so a deadman stop costs the frames sent before the client heard of it and
+    not the rest of the run."""
     import websocket
 
     ws = websocket.create_connection(url.replace("http://", "ws://") + "/ws/teleop?name=bench", timeout=10)
     hello = json.loads(ws.recv())
     assert hello["type"] == "hello"
+    ws.heard = Heard(hello["epoch"])
 
     def drain() -> None:
         try:
-            while ws.recv_data_frame(control_frame=True)[0] != websocket.ABNF.OPCODE_CLOSE:
-                pass
+            while True:
+                opcode, data = ws.recv_data_frame(control_frame=True)
+                if opcode == websocket.ABNF.OPCODE_CLOSE:
+                    return
+                if opcode == websocket.ABNF.OPCODE_TEXT:
+                    ws.heard.note(json.loads(data.data))
         except Exception:
             pass
 
@@ -112,8 +135,8 @@ def hang_up(ws) -> None:
     ws.shutdown()
 
 
-def frame(linear: float, angular: float = 0.0) -> str:
-    return json.dumps({"linear": linear, "angular": angular})
+def frame(linear: float, angular: float = 0.0, epoch: int = 0) -> str:
+    return json.dumps({"linear": linear, "angular": angular, "epoch": epoch})
 
 
 def on_grid(n: int, rate_hz: float, send) -> list[float]:
@@ -159,10 +182,11 @@ def encoded(text: str) -> bytes:
 
 def bench_frames(server: Server, sub: Subscriber, baseline: Baseline | None, n: int, block: int) -> None:
     ws = connect(server.url)
-    frames = [encoded(frame(value(i, n))) for i in range(n)]
     app, base = [], []
     cpu_s = run_s = 0.0
     for indices in blocks(n, block):
+        epoch = ws.heard.epoch
+        frames = {i: encoded(frame(value(i, n), epoch=epoch)) for i in indices}
         mark = sub.mark()
         cpu0, t0 = server.cpu_seconds(), time.monotonic()
         times = on_grid(len(indices), RATE_HZ, lambda k: ws.sock.sendall(frames[indices[k]]))
@@ -172,8 +196,10 @@ def bench_frames(server: Server, sub: Subscriber, baseline: Baseline | None, n: 
         app += match_latencies(sub, mark, dict(zip(indices, times)), n, MAX_LINEAR)
         if baseline is not None:
             base += baseline.run(indices, n)
+    said = ", ".join(f"{k} x{v}" for k, v in sorted(ws.heard.counts.items()))
     print(f"frame -> /cmd_vel at 40 Hz: {summary_ms(app)}  received {len(app)}/{n}  "
-          f"server CPU {100 * cpu_s / run_s:.1f}% of one core  RSS {server.rss_mb():.0f} MB", flush=True)
+          f"server CPU {100 * cpu_s / run_s:.1f}% of one core  RSS {server.rss_mb():.0f} MB"
+          + (f"  (the server said: {said})" if said else ""), flush=True)
     if baseline is not None:
         print(f"baseline rclpy -> rclpy:    {summary_ms(base)}  received {len(base)}/{n}  "
               f"(blocks of {block}, alternating with the app's)", flush=True)
@@ -207,7 +233,9 @@ def bench_rate(server: Server, sub: Subscriber, hold_s: float) -> None:
     on_grid(int(hold_s * 10), 10.0, lambda i: ws.send(frame(0.5)))
     end = sub.mark()
     ws.send(json.dumps({"stop": True}))
-    times = [t for t, lin, _ in sub.since(mark)[: end - mark] if lin == 2.5]
+    # From the first repeat on: the input itself goes out at once, and the first repeat after it
+    # comes 1.2 periods later by design (teleop_control.INPUT_REPEAT_DELAY).
+    times = [t for t, lin, _ in sub.since(mark)[: end - mark] if lin == 2.5][1:]
     gaps = [b - a for a, b in zip(times, times[1:])]
     period = 1.0 / RATE_HZ
     dev_ms = [abs(g - period) * 1000 for g in gaps]

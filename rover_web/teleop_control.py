@@ -100,6 +100,13 @@ class Command:
     expires_at: float            # deadman deadline, or the end of a REST command's duration
 
 
+# After a fresh input the first repeat waits a little longer than one period. An input stream at
+# about the repeat rate (a client sending at rate_hz) would otherwise race the repeater at every
+# frame: the repeat of the old value goes out just before each new one, doubling the rate and,
+# holding the lock, delaying the new value (bench/teleop.py sends on a 40 Hz grid).
+INPUT_REPEAT_DELAY = 1.2
+
+
 class TeleopController:
     def __init__(self, output, limits: Limits, *, rate_hz: float = 40.0, deadman_s: float = 0.3,
                  clock: Callable[[], float] = time.monotonic, wall_clock: Callable[[], float] = time.time,
@@ -205,7 +212,7 @@ class TeleopController:
             if (previous is None or previous.session is not session
                     or (previous.linear_mps, previous.angular_rps) != (linear_mps, angular_rps)):
                 self._publish(linear_mps, angular_rps)
-                self._next_tick = now + self.period_s
+                self._next_tick = now + self.period_s * INPUT_REPEAT_DELAY
             self.stats["inputs"] += 1
             self._changed()
             self._cond.notify_all()

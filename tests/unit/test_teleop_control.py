@@ -4,7 +4,8 @@ import math
 
 import pytest
 
-from rover_web.teleop_control import Limits, Refused, Repeater, TeleopController, fraction, scale
+from rover_web.teleop_control import (INPUT_REPEAT_DELAY, Limits, Refused, Repeater, TeleopController, fraction,
+                                      scale)
 
 LIMITS = Limits(5.0, 2.0)
 
@@ -77,8 +78,9 @@ def test_new_input_is_published_at_once_and_repeated_on_a_fixed_grid(rig):
     run_until(ctl, clock, 100.701)
     times = [t for t, lin, _ in out.sent if lin == 2.5]
     gaps = [b - a for a, b in zip(times, times[1:])]
-    assert all(abs(g - 0.025) < 1e-9 for g in gaps), gaps
-    assert len(times) == 29  # 0.7 s at 40 Hz, plus the first
+    assert gaps[0] == pytest.approx(0.025 * INPUT_REPEAT_DELAY)  # the first repeat after the input
+    assert all(abs(g - 0.025) < 1e-9 for g in gaps[1:]), gaps
+    assert len(times) == 28  # the input, then 40 Hz from 30 ms after it
 
 
 def test_changed_input_goes_out_immediately_and_restarts_the_grid(rig):
@@ -88,7 +90,20 @@ def test_changed_input_goes_out_immediately_and_restarts_the_grid(rig):
     clock.advance(0.01)
     ctl.drive(s, 0.4, 0)
     assert out.sent[-1] == (100.01, 2.0, 0.0)
-    assert ctl.tick() == pytest.approx(100.035)
+    assert ctl.tick() == pytest.approx(100.01 + 0.025 * INPUT_REPEAT_DELAY)
+
+
+def test_inputs_at_the_repeat_rate_are_not_doubled_by_repeats(rig):
+    """A client sending at rate_hz, arriving up to 2 ms late or early: every input goes out, and
+    no repeat of the previous value is squeezed in before it."""
+    ctl, clock, out, _ = rig
+    s = ctl.connect()
+    jitter = [0.0, 0.002, -0.002, 0.0015, -0.001, 0.002]
+    for i in range(40):
+        run_until(ctl, clock, 100.0 + i * 0.025 + jitter[i % len(jitter)])
+        ctl.drive(s, 0.1 + i * 0.01, 0)
+    assert ctl.stats["repeated"] == 0
+    assert [lin for _, lin, _ in out.sent] == [pytest.approx((0.1 + i * 0.01) * 5) for i in range(40)]
 
 
 def test_deadman_stops_exactly_once_and_bumps_the_epoch(rig):
