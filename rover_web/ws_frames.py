@@ -95,22 +95,32 @@ class FrameParser:
 
     def __init__(self, max_message_bytes: int):
         self.max_message_bytes = max_message_bytes
-        self._buffer = b""
-        self._fragments: list[bytes] | None = None  # of a message still waiting for its final frame
-        self._fragment_opcode = 0
+        # Bytes of a frame still arriving. A bytearray: a big frame trickled in a byte at a time
+        # must cost appends, not a copy of everything so far for every byte.
+        self._buffer = bytearray()
+        self._fragments: list | None = None  # of a message still waiting for its final frame
         self._fragment_bytes = 0
-        self._decoder = None
+        self._decoder = None  # a text message's incremental UTF-8 decoder; None for binary
 
     def feed(self, data: bytes) -> list[tuple[str, object]]:
         events: list[tuple[str, object]] = []
+        buffer = self._buffer
+        if buffer:
+            buffer += data
+            data = buffer
         try:
-            self._parse(self._buffer + data if self._buffer else data, events)
+            used = self._parse(data, events)
         except ProtocolError as exc:
             exc.events = events
             raise
+        if data is buffer:
+            del buffer[:used]
+        elif used < len(data):
+            buffer += data[used:]
         return events
 
-    def _parse(self, buffer: bytes, events: list) -> None:
+    def _parse(self, buffer: bytes | bytearray, events: list) -> int:
+        """Complete frames from the start of `buffer` into `events`; how many bytes they took."""
         start, end = 0, len(buffer)
         while end - start >= 2:
             b0, b1 = buffer[start], buffer[start + 1]
@@ -144,7 +154,7 @@ class FrameParser:
                 events.append(event)
                 if event[0] == "close":
                     break
-        self._buffer = buffer[start:] if start < end else b""
+        return start
 
     def _check_header(self, opcode: int, final: int, size: int) -> None:
         if opcode >= OP_CLOSE:
@@ -180,7 +190,7 @@ class FrameParser:
                     return "text", payload.decode("utf-8")
                 except UnicodeDecodeError:
                     raise ProtocolError(CLOSE_INVALID_PAYLOAD, "a text message must be UTF-8") from None
-            self._fragments, self._fragment_opcode, self._fragment_bytes = [], opcode, 0
+            self._fragments, self._fragment_bytes = [], 0
             # Text is checked fragment by fragment, so bad UTF-8 fails the connection at once.
             self._decoder = codecs.getincrementaldecoder("utf-8")() if opcode == OP_TEXT else None
         self._fragment_bytes += len(payload)
