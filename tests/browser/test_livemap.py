@@ -1,5 +1,6 @@
 """The live map page in Chromium: robot on the canvas, click and drag goals, waypoints, maps, zoom."""
 
+import json
 import math
 import time
 from urllib.parse import quote
@@ -88,9 +89,14 @@ def goal_peer(ros_peer):
     return peer
 
 
-def goal_answered(page):
-    """Wait in Playwright: its request routing (PageWatch) only runs while the test is inside a Playwright call."""
-    page.wait_for_function("window.liveMapState.lastGoal && window.liveMapState.lastGoal.status !== 'sending'")
+def goal_answered(page, after=None):
+    """The answered goal request, waiting in Playwright: its request routing (PageWatch) only runs
+    while the test is inside a Playwright call. `after`: an earlier answer, which does not count
+    (the page may not have sent the next goal yet when the test starts waiting)."""
+    page.wait_for_function(
+        """previous => { const g = window.liveMapState.lastGoal;
+                         return g && g.status !== 'sending' && JSON.stringify(g.request) !== previous; }""",
+        arg=json.dumps(after["request"], separators=(",", ":")) if after else None)
     return state(page)["lastGoal"]
 
 
@@ -148,7 +154,7 @@ def test_click_and_drag_on_the_map_send_goals_a_subscriber_receives(live_server,
     assert page.locator("#livemap-goal-mode").get_attribute("aria-pressed") == "true"
     x, y = expected_screen(s, 12.0, 10.5)
     page.mouse.click(left + x, top + y)
-    goal_answered(page)
+    first = goal_answered(page)
     msg = goal_peer.wait_for("/goal_pose")["msg"]
     assert msg["header"]["frame_id"] == "map"
     tolerance = 0.05 / s["view"]["scale"] + 0.01   # within a screen pixel
@@ -165,7 +171,7 @@ def test_click_and_drag_on_the_map_send_goals_a_subscriber_receives(live_server,
     page.mouse.move(left + x + 30, top + y - 30, steps=5)
     page.mouse.move(left + x + 60, top + y - 60, steps=5)
     page.mouse.up()
-    assert goal_answered(page)["request"]["x"] == pytest.approx(23.0, abs=tolerance)
+    assert goal_answered(page, after=first)["request"]["x"] == pytest.approx(23.0, abs=tolerance)
     msg = goal_peer.wait_for("/goal_pose")["msg"]
     assert msg["pose"]["position"]["x"] == pytest.approx(23.0, abs=tolerance)
     assert msg["pose"]["position"]["y"] == pytest.approx(10.5, abs=tolerance)
