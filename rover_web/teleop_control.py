@@ -54,7 +54,10 @@ def fraction(value: Any) -> float:
     """A joystick axis as a fraction in [-1, 1]; anything non-finite or not a number is 0 (stop)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return 0.0
-    value = float(value)
+    try:
+        value = float(value)
+    except OverflowError:  # an integer too large for a float: no more a number to drive by than inf
+        return 0.0
     if not math.isfinite(value):
         return 0.0
     return max(-1.0, min(1.0, value))

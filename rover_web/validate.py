@@ -46,6 +46,15 @@ def loads_strict(data: bytes | str) -> Any:
         raise InvalidInput("body is nested too deeply", "bad_json") from None
 
 
+_JSON_TYPES = {dict: "an object", list: "an array", str: "a string", bool: "a boolean", type(None): "null",
+               int: "a number", float: "a number"}
+
+
+def json_type(value: Any) -> str:
+    """What a decoded JSON value is, in JSON's words (an integer and a float are both a number)."""
+    return _JSON_TYPES.get(type(value), type(value).__name__)
+
+
 def number(obj: dict, key: str, *, low: float | None = None, high: float | None = None,
            default: Any = ..., required: bool = True) -> float:
     """A finite number field within [low, high]; booleans and strings are refused."""
@@ -56,7 +65,10 @@ def number(obj: dict, key: str, *, low: float | None = None, high: float | None 
     value = obj[key]
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise InvalidInput(f"'{key}' must be a number, got {type(value).__name__}", "bad_type")
-    value = float(value)
+    try:
+        value = float(value)
+    except OverflowError:  # an integer of hundreds of digits: JSON allows it, a float cannot hold it
+        raise InvalidInput(f"'{key}' is out of range: an integer too large for a number", "out_of_range") from None
     if not math.isfinite(value):
         raise InvalidInput(f"'{key}' must be finite", "non_finite")
     if low is not None and value < low or high is not None and value > high:

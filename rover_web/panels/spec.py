@@ -108,12 +108,12 @@ def coerce(stype: ScalarType, value: Any, *, low: float | None = None, high: flo
             if not value.is_integer():
                 raise InvalidValue(f"must be an integer for {stype.short}, got {value:g}", "bad_type")
             value = int(value)
-    else:
-        value = float(value)
-    if value < low or value > high:
-        raise InvalidValue(f"must be from {_num(low)} to {_num(high)} for {stype.short}, got {_num(value)}",
+    if value < low or value > high:  # before float(): an integer of hundreds of digits overflows it
+        huge = isinstance(value, int) and abs(value) >= 10 ** 30
+        shown = f"an integer of {len(str(abs(value)))} digits" if huge else _num(value)
+        raise InvalidValue(f"must be from {_num(low)} to {_num(high)} for {stype.short}, got {shown}",
                            "out_of_range")
-    return value
+    return value if stype.kind == "int" else float(value)
 
 
 def _num(value: float) -> str:

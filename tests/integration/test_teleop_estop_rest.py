@@ -173,7 +173,8 @@ def test_rest_bad_input_is_400_and_publishes_nothing(rig, body, code):
 
 
 @pytest.mark.parametrize("raw", ['{"command": "forward", "speed": NaN}', '{"command": "forward", "speed": Infinity}',
-                                 '{"command": "forward", "speed": 1e400}', '{"command": "forward"', '[1]'])
+                                 '{"command": "forward", "speed": 1e400}', '{"command": "forward"', '[1]',
+                                 '{"command": "forward", "speed": 1' + "0" * 400 + '}'])  # float() of it overflows
 def test_rest_non_finite_and_broken_json_is_400(client, raw):
     response = client.post("/api/teleop", data=raw, content_type="application/json")
     assert response.status_code == 400 and response.json["error"]

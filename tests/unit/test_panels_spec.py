@@ -95,6 +95,10 @@ def test_float_bool_and_string_values():
     with pytest.raises(spec.InvalidValue, match="out|from"):
         spec.coerce(f32, 1e39)  # fits a double, not a float
     assert spec.coerce(f64, 1e300) == 1e300
+    for huge in (10 ** 400, -10 ** 400):  # valid JSON; float() of it would raise OverflowError
+        with pytest.raises(spec.InvalidValue) as err:
+            spec.coerce(f64, huge)
+        assert err.value.code == "out_of_range" and "401 digits" in str(err.value)
     for bad in (math.nan, math.inf, -math.inf):
         with pytest.raises(spec.InvalidValue) as err:
             spec.coerce(f64, bad)

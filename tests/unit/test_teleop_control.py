@@ -63,7 +63,7 @@ def run_until(ctl, clock, t_end):
 def test_fraction_and_scale_clamp_and_refuse_non_finite():
     assert scale(0.5, -0.25, LIMITS) == (2.5, -0.5)
     assert scale(3, -7, LIMITS) == (5.0, -2.0)
-    for bad in (math.nan, math.inf, -math.inf, "1", None, True):
+    for bad in (math.nan, math.inf, -math.inf, "1", None, True, 10 ** 400, -10 ** 400):
         assert fraction(bad) == 0.0
 
 

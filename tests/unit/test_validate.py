@@ -21,7 +21,8 @@ def test_number_checks_type_range_and_default():
     assert number({"v": 1}, "v", low=0, high=2) == 1.0
     assert number({}, "v", default=0.5) == 0.5
     for bad, code in [({"v": True}, "bad_type"), ({"v": "1"}, "bad_type"), ({"v": None}, "bad_type"),
-                      ({"v": 3}, "out_of_range"), ({}, "missing_field")]:
+                      ({"v": 3}, "out_of_range"), ({}, "missing_field"),
+                      ({"v": 10 ** 400}, "out_of_range"), ({"v": -10 ** 400}, "out_of_range")]:  # no OverflowError
         with pytest.raises(InvalidInput) as err:
             number(bad, "v", low=0, high=2)
         assert err.value.code == code
