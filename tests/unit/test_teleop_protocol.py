@@ -1,10 +1,15 @@
 """Teleop WebSocket frames: what is accepted, what gets an error frame, what closes the socket."""
 
 import json
+from unittest import mock
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
+from rover_web import teleop_protocol
 from rover_web.teleop_protocol import Control, Drive, FrameError, parse_frame
+from rover_web.validate import loads_strict
 
 MAX = 4096
 
@@ -70,3 +75,41 @@ def test_limit_is_inclusive():
     padded = frame[:-1] + ' ' * (MAX - len(frame)) + '}'
     assert len(padded.encode()) == MAX
     assert parse_frame(padded, MAX) == Drive(0.0, 0.0)
+
+
+# --- orjson, with the standard decoder behind it, decides every frame as the standard one alone ---
+
+json_numbers = st.one_of(
+    st.floats(allow_nan=False, allow_infinity=False), st.floats(min_value=-1.0, max_value=1.0),
+    st.integers(), st.integers(min_value=-10 ** 400, max_value=10 ** 400), st.sampled_from([2 ** 63, 2 ** 64, -2 ** 63 - 1]))
+json_values = st.recursive(
+    st.one_of(json_numbers, st.booleans(), st.none(), st.text(max_size=8)),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=6), inner, max_size=3), max_leaves=8)
+frame_keys = st.sampled_from(["linear", "angular", "epoch", "source", "stop", "takeover", "release", "x", "\ud800"])
+frame_texts = st.one_of(
+    st.dictionaries(frame_keys, json_values, max_size=5).map(json.dumps),
+    st.fixed_dictionaries({"linear": json_numbers, "angular": json_numbers},
+                          optional={"epoch": json_numbers, "source": st.sampled_from(["joystick", "keyboard", "\ud800"])}
+                          ).map(json.dumps),
+    json_values.map(json.dumps),
+    st.tuples(st.sampled_from(['{"linear": %s, "angular": 0}', '{"epoch": %s, "linear": 0, "angular": 0}', '[%s]']),
+              st.sampled_from(["NaN", "-Infinity", "1e400", "-1e999", "1" + "0" * 400, "0.1e-400", "01", "1.", "-",
+                               '"\\ud800"', "1E+2", "-0", "true", "null"])).map(lambda t: t[0] % t[1]),
+    st.text(max_size=30),
+)
+
+
+def outcome(text):
+    try:
+        return ("ok", parse_frame(text, MAX))
+    except FrameError as exc:
+        return ("error", exc.code, exc.message, exc.close_code)
+
+
+@settings(max_examples=1500, deadline=None)
+@given(frame_texts)
+def test_orjson_and_the_standard_decoder_decide_every_frame_alike(text):
+    fast = outcome(text)
+    with mock.patch.object(teleop_protocol, "_loads", loads_strict):
+        standard = outcome(text)
+    assert fast == standard
