@@ -6,20 +6,23 @@ import time
 import requests
 import websocket
 
+from rover_web.ws_frames import OP_CLOSE
+from tests import ws_wire
 from tests.teleop_support import TeleopClient
 
 PING_S = 0.3
 
 
-def close_codes(raw: bytes) -> list[int]:
-    """Close codes in a stream of unmasked server frames, up to the first bytes that are not a frame."""
-    codes, i = [], 0
-    while i + 2 <= len(raw) and raw[i] & 0x0F in (0x1, 0x2, 0x8, 0x9, 0xA) and raw[i + 1] < 126:
-        opcode, size = raw[i] & 0x0F, raw[i + 1]
-        if opcode == 0x8:
-            codes.append(struct.unpack("!H", raw[i + 2:i + 4])[0])
-        i += 2 + size
-    return codes
+def close_codes(sock) -> list[int]:
+    """Close codes among the server's frames, read until the connection ends."""
+    codes = []
+    while True:
+        try:
+            opcode, payload = ws_wire.read_frame(sock)
+        except EOFError:
+            return codes
+        if opcode == OP_CLOSE:
+            codes.append(struct.unpack("!H", payload[:2])[0])
 
 
 def holder(url):
@@ -57,9 +60,6 @@ def test_a_client_that_stops_answering_pings_loses_the_socket_and_control(live_s
         # It never answers the close either (a raw read, so websocket-client cannot answer for
         # it): the server cuts the connection rather than keep a thread and a socket for it.
         mute.sock.settimeout(5)
-        raw = b""
-        while chunk := mute.sock.recv(4096):
-            raw += chunk
-        assert close_codes(raw) == [1008]
+        assert close_codes(mute.sock) == [1008]
     finally:
         mute.close()
