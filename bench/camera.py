@@ -21,7 +21,7 @@ import requests
 from common import ROOT, Server, machine, percentile, ros_env
 
 sys.path.insert(0, str(ROOT))
-from tests.mjpeg import MjpegClient  # noqa: E402
+from tests.support.mjpeg import MjpegClient  # noqa: E402
 
 TOPIC = "/camera/image_raw"
 

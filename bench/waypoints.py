@@ -136,8 +136,8 @@ def main() -> None:
     env = ros_env(ROVER_WEB_DB_PATH=str(db_path), ROVER_WEB_MAX_WAYPOINTS="100000",
                   ROVER_WEB_MAP_TILES=str(work / "no-tiles"))
     os.environ.update({k: env[k] for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")})
-    from tests.rospeer import RosPeer  # after the domain is set: the peer inherits this environment
-    from tests.waypoint_helpers import warm_up_topic
+    from tests.support.rospeer import RosPeer  # after the domain is set: the peer inherits this environment
+    from tests.support.waypoint_helpers import warm_up_topic
 
     server = Server(env, kind=args.server)
     peer = RosPeer("bench_waypoints")

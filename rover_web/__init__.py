@@ -16,9 +16,9 @@ from typing import Any, Mapping
 
 from flask import Flask
 
-from . import config as config_module
+from rover_web import config as config_module
 from .config import ConfigError
-from .events import EventHub
+from rover_web.events.hub import EventHub
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -96,7 +96,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     if test_config:
         app.config.update({k: v for k, v in test_config.items() if not k.startswith(config_module.PREFIX)})
 
-    from . import http, pages, sse, status
+    from .web import http, pages, sse, status
 
     http.init_app(app)
     for name in CLI_MODULES:
@@ -109,11 +109,11 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
 
     from .ros import require_rclpy
     require_rclpy()
-    from .core import Rover
-    from .db import Database, database_path
-    from .sse_broadcast import Broadcaster
-    from .motion import CmdVelOutput
-    from .ros.runtime import RosRuntime
+    from rover_web.core.state import Rover
+    from rover_web.storage.db import Database, database_path
+    from rover_web.events.broadcast import Broadcaster
+    from rover_web.ros.cmd_vel import CmdVelOutput
+    from rover_web.ros.runtime import RosRuntime
 
     runtime = RosRuntime(settings["ROVER_WEB_NODE_NAME"], settings["ROVER_WEB_ROS_DOMAIN_ID"])
     try:

@@ -15,7 +15,11 @@ import os
 import re
 import tomllib
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Callable, Mapping
+
+# The checkout (or install) root: templates/, static/ and map_files/ are found from here.
+ROOT = Path(__file__).resolve().parent.parent
 
 PREFIX = "ROVER_WEB_"
 CONFIG_FILE_VAR = "ROVER_WEB_CONFIG"

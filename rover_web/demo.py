@@ -27,7 +27,7 @@ def main(argv: list[str] | None = None) -> int:
         os.environ["ROS_DOMAIN_ID"] = str(args.domain_id)
     os.environ.setdefault("ROS_DOMAIN_ID", "42")
 
-    from . import create_app
+    from rover_web import create_app
 
     app = create_app()
     config = app.config

@@ -20,7 +20,7 @@ from PIL import Image, ImageDraw
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from rover_web.map_geometry import MapGeometry  # noqa: E402
+from rover_web.livemap.geometry import MapGeometry  # noqa: E402
 
 FREE, WALL, UNKNOWN = 254, 0, 205
 OUT = ROOT / "map_files"

@@ -12,8 +12,8 @@ import time
 from pathlib import Path
 
 import pytest
+from rover_web.config import ROOT
 
-ROOT = Path(__file__).resolve().parent.parent
 
 
 def pytest_configure(config):
@@ -111,7 +111,7 @@ class ServerProcess:
     """`flask --app rover_web run --no-reload` in its own process, as an operator starts it."""
 
     def __init__(self, port: int | None = None, env: dict | None = None, args: list[str] | None = None):
-        from tests.rospeer import subprocess_env
+        from tests.support.rospeer import subprocess_env
 
         self.port = port or free_port()
         self.url = f"http://127.0.0.1:{self.port}"
@@ -174,7 +174,7 @@ def server_process(tmp_path):
 
 @pytest.fixture
 def ros_peer():
-    from tests.rospeer import RosPeer
+    from tests.support.rospeer import RosPeer
 
     peers = []
 
@@ -192,7 +192,7 @@ class SimProcess:
     """`python -m rover_web.sim` (or one part, e.g. module="rover_web.sim.drone") in its own process."""
 
     def __init__(self, args: list[str], module: str = "rover_web.sim"):
-        from tests.rospeer import subprocess_env
+        from tests.support.rospeer import subprocess_env
 
         self.proc = subprocess.Popen([sys.executable, "-m", module, *args], cwd=ROOT,
                                      env=subprocess_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
@@ -235,7 +235,7 @@ def sim_process():
 
 @pytest.fixture
 def sse_client():
-    from tests.sse import SseClient
+    from tests.support.sse import SseClient
 
     clients = []
 

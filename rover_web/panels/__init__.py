@@ -8,14 +8,14 @@ routes (pages and API).
 
 from __future__ import annotations
 
-from ..core import Rover
+from rover_web.core.state import Rover
 from . import routes, spec
 from .oplog import OperatorLog
 from .service import PanelService
 
 
 def init_app(app, rover: Rover) -> None:
-    from ..ros.panel_msgs import field_kind
+    from .msgs import field_kind
 
     config = rover.config
     specs = spec.load(config["ROVER_WEB_PANELS_FILE"], config["ROVER_WEB_STALE_AFTER_S"], field_kind)

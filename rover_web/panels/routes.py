@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from flask import Blueprint, abort, current_app, jsonify, render_template, request
 
-from ..http import ApiError, json_body
+from rover_web.web.http import ApiError, json_body
 from .service import PanelService
 
 bp = Blueprint("panels", __name__)

@@ -13,9 +13,9 @@ import threading
 import time
 from typing import Any
 
-from ..http import ApiError
-from ..ros import panel_msgs
-from ..validate import InvalidInput, only_keys
+from rover_web.web.http import ApiError
+from . import msgs as panel_msgs
+from rover_web.web.validate import InvalidInput, only_keys
 from .oplog import OperatorLog
 from .spec import ControlSpec, InvalidValue, PanelSpec
 from .state import PanelState

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-from ..config import _TOPIC_RE, ConfigError
+from rover_web.config import _TOPIC_RE, ConfigError
 
 DEFAULT_FILE = Path(__file__).with_name("drone.toml")
 ID_RE = re.compile(r"^[a-z][a-z0-9_-]{0,31}$")

@@ -21,7 +21,7 @@ from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import get_rmw_implementation_identifier
 
-from ..topic_stats import TopicStats
+from .topic_stats import TopicStats
 from . import qos as qos_profiles
 from .typesupport import message_class, type_name
 

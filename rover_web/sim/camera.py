@@ -18,8 +18,8 @@ from PIL import ImageDraw
 from rclpy.node import Node
 from sensor_msgs.msg import Image
 
-from ..imaging import font
-from ..ros import qos as qos_profiles
+from rover_web.camera.imaging import font
+from rover_web.ros import qos as qos_profiles
 
 # SMPTE-like bars: white, yellow, cyan, green, magenta, red, blue, black.
 BARS = ((235, 235, 235), (235, 235, 16), (16, 235, 235), (16, 235, 16),

@@ -31,7 +31,7 @@ from geometry_msgs.msg import Point
 from rclpy.node import Node
 from std_msgs.msg import Int8, String
 
-from ..ros import qos
+from rover_web.ros import qos
 
 STANDBY, FLYING, HOVERING = "Standby", "Flying", "Hovering"
 PHASE_STOP, PHASE_TAKE_OFF, PHASE_RETURN = 0, 1, 2

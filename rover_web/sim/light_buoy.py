@@ -22,8 +22,8 @@ from typing import Sequence
 from rclpy.node import Node
 from std_msgs.msg import Empty, String
 
-from ..light_sequence import BLACK, CODE_LENGTH, parse_colours
-from ..ros import qos
+from rover_web.scan_the_code.light_sequence import BLACK, CODE_LENGTH, parse_colours
+from rover_web.ros import qos
 
 DEFAULT_COLOURS = ("red", "green", "blue", "yellow")
 # What a confused detector might report instead of the true colour, besides other colours and black.

@@ -25,8 +25,8 @@ from nav_msgs.msg import Odometry, Path
 from rclpy.node import Node
 from sensor_msgs.msg import NavSatFix, NavSatStatus
 
-from ..ros import qos
-from ..ros.convert import quaternion_from_yaw, yaw_from_quaternion
+from rover_web.ros import qos
+from rover_web.ros.convert import quaternion_from_yaw, yaw_from_quaternion
 
 EARTH_RADIUS_M = 6378137.0
 BENDERSON_LAT = 27.3742443
@@ -277,7 +277,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def default_start(maps_file: str | None = None) -> tuple[float, float, float]:
     """The first waypoint (else the centre) of the first map the GUI will show."""
-    from ..map_files import first_waypoint_or_centre, load_catalog, maps_file_path
+    from rover_web.livemap.map_files import first_waypoint_or_centre, load_catalog, maps_file_path
 
     path = maps_file_path(maps_file or os.environ.get("ROVER_WEB_MAPS_FILE") or "map_files/all_maps.json")
     first = next(iter(load_catalog(path).values()))

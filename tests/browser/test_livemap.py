@@ -8,7 +8,7 @@ from urllib.parse import quote
 import pytest
 import requests
 
-from rover_web.map_files import load_catalog, maps_file_path
+from rover_web.livemap.map_files import load_catalog, maps_file_path
 
 pytestmark = pytest.mark.browser
 

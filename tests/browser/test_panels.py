@@ -3,7 +3,7 @@
 import pytest
 from playwright.sync_api import expect
 
-from tests.panels_support import drone_sim, post, wait_display, wait_subscribers  # noqa: F401 (fixture)
+from tests.support.panels_support import drone_sim, post, wait_display, wait_subscribers  # noqa: F401 (fixture)
 
 pytestmark = pytest.mark.browser
 

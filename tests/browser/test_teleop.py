@@ -9,7 +9,7 @@ import time
 
 import pytest
 
-from tests.teleop_support import is_zero, subscribe_cmd_vel, twists, warm_up
+from tests.support.teleop_support import is_zero, subscribe_cmd_vel, twists, warm_up
 
 pytestmark = pytest.mark.browser
 

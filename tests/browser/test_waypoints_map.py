@@ -10,12 +10,12 @@ import time
 import numpy as np
 import pytest
 
-from tests.rospeer import subprocess_env
-from tests.waypoint_helpers import FLOAT64_MULTI_ARRAY, TileServer, stored_rows, warm_up_topic
+from tests.support.rospeer import subprocess_env
+from tests.support.waypoint_helpers import FLOAT64_MULTI_ARRAY, TileServer, stored_rows, warm_up_topic
+from rover_web.config import ROOT
 
 pytestmark = pytest.mark.browser
 
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def open_map(page, url):

@@ -10,7 +10,7 @@ import psutil
 import requests
 
 from tests.conftest import free_port
-from tests.rospeer import ROOT, subprocess_env
+from tests.support.rospeer import ROOT, subprocess_env
 
 
 def test_demo_serves_the_simulated_robot_and_one_ctrl_c_stops_everything(tmp_path):

@@ -9,7 +9,7 @@ import time
 
 import pytest
 
-from tests.rospeer import ROOT, subprocess_env
+from tests.support.rospeer import ROOT, subprocess_env
 
 TWIST = "geometry_msgs/msg/Twist"
 

@@ -1,0 +1,48 @@
+"""Messages of the waypoints feature: Float64MultiArray out (/waypoints, /mission), NavSatFix in."""
+
+from __future__ import annotations
+
+import math
+from typing import Sequence
+
+from .gps import FixReading
+from rover_web.ros.typesupport import message_class
+
+FLOAT64_MULTI_ARRAY = "std_msgs/msg/Float64MultiArray"
+NAV_SAT_FIX = "sensor_msgs/msg/NavSatFix"
+
+
+def waypoint_message(lng: float, lat: float):
+    """data [lng, lat] with an empty layout, exactly as the RobotX GUI published it."""
+    msg = message_class(FLOAT64_MULTI_ARRAY)()
+    msg.data = [float(lng), float(lat)]
+    return msg
+
+
+def mission_message(points: Sequence[tuple[float, float]]):
+    """The ordered mission as one n x 2 row-major array: [lng0, lat0, lng1, lat1, ...].
+
+    dim[0] "waypoints" (size n, stride 2n) and dim[1] "lng_lat" (size 2, stride 2), following the
+    MultiArrayLayout convention that a dimension's stride is the number of elements it spans.
+    """
+    cls = message_class(FLOAT64_MULTI_ARRAY)
+    dim_cls = message_class("std_msgs/msg/MultiArrayDimension")
+    msg = cls()
+    n = len(points)
+    msg.layout.dim = [dim_cls(label="waypoints", size=n, stride=2 * n),
+                      dim_cls(label="lng_lat", size=2, stride=2)]
+    msg.layout.data_offset = 0
+    msg.data = [float(v) for lng, lat in points for v in (lng, lat)]
+    return msg
+
+
+def fix_reading(msg) -> FixReading:
+    """The numbers the map needs from a NavSatFix; judging them is rover_web.gps's job."""
+    sigma = None
+    if msg.position_covariance_type != 0:  # COVARIANCE_TYPE_UNKNOWN
+        cov = msg.position_covariance
+        east, north = float(cov[0]), float(cov[4])
+        if math.isfinite(east) and math.isfinite(north) and east >= 0 and north >= 0:
+            sigma = math.sqrt((east + north) / 2)
+    return FixReading(status=int(msg.status.status), lat=float(msg.latitude), lng=float(msg.longitude),
+                      alt=float(msg.altitude), horizontal_sigma_m=sigma)
