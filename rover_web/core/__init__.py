@@ -1,0 +1,1 @@
+"""What every feature shares: the per-app state (Rover), background loops and leases."""

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import threading
 import time
 
 from flask import Blueprint, jsonify
@@ -46,19 +45,9 @@ def status():
     return jsonify(build_status(current_rover()))
 
 
-def start_reporter(rover: Rover) -> threading.Thread:
+def start_reporter(rover: Rover) -> None:
     """Publish the status every STATUS_PERIOD_S; it is also the pages' heartbeat."""
-    period_s = rover.config["ROVER_WEB_STATUS_PERIOD_S"]
-
-    def run() -> None:
-        while not rover.stopping.wait(period_s):
-            try:
-                rover.hub.publish("status", build_status(rover))
-            except Exception:  # pragma: no cover - never let the heartbeat die silently
-                rover.runtime.node.get_logger().error("status reporter failed")
-
     rover.hub.register("status")
     rover.hub.publish("status", build_status(rover))
-    thread = threading.Thread(target=run, name="status-reporter", daemon=True)
-    thread.start()
-    return thread
+    rover.every(rover.config["ROVER_WEB_STATUS_PERIOD_S"], lambda: rover.hub.publish("status", build_status(rover)),
+                name="status-reporter")

@@ -62,7 +62,7 @@ def test_bad_file_names_the_file(tmp_path):
 
 
 def test_readme_documents_every_setting():
-    from rover_web import ROOT
+    from rover_web.config import ROOT
 
     readme = (ROOT / "README.md").read_text()
     missing = [config.PREFIX + s.name for s in config.SETTINGS if f"`{config.PREFIX}{s.name}`" not in readme]

@@ -169,7 +169,7 @@ def test_bad_goals_are_400_and_publish_nothing(client, ros_peer):
 
 
 def test_maps_settings_default_map_single_yaml_and_none(app_factory):
-    from rover_web import ROOT
+    from rover_web.config import ROOT
     from rover_web.config import ConfigError
 
     with pytest.raises(ConfigError, match="ROVER_WEB_LIVEMAP_DEFAULT_MAP: no map named 'Attic'"):

@@ -182,7 +182,7 @@ def test_rest_non_finite_and_broken_json_is_400(client, raw):
 
 
 def test_default_rest_duration_may_not_exceed_the_maximum(app_factory):
-    from rover_web import ConfigError
+    from rover_web.config import ConfigError
 
     with pytest.raises(ConfigError, match="TELEOP_REST_DEFAULT_DURATION_S"):
         app_factory(ROVER_WEB_TELEOP_REST_DEFAULT_DURATION_S=6.0, ROVER_WEB_TELEOP_REST_MAX_DURATION_S=5.0)

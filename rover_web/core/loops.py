@@ -1,0 +1,59 @@
+"""Background loops that stop with the app: `every(period_s, fn)` instead of hand-written threads.
+
+A loop calls `fn` every `period_s` until its stop event is set; an exception is logged and the
+loop goes on (a heartbeat or a watchdog must outlive a bug). The owner joins it at shutdown.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from typing import Callable
+
+log = logging.getLogger(__name__)
+
+
+class Loop:
+    def __init__(self, name: str, period_s: float, fn: Callable[[], object], stopping: threading.Event, *,
+                 immediately: bool = False):
+        if not period_s > 0:
+            raise ValueError(f"loop {name!r}: period_s must be positive, got {period_s!r}")
+        self.name = name
+        self.period_s = period_s
+        self._fn = fn
+        self._stopping = stopping
+        self._immediately = immediately
+        self._thread = threading.Thread(target=self._run, name=name, daemon=True)
+
+    def start(self) -> Loop:
+        self._thread.start()
+        return self
+
+    def _run(self) -> None:
+        if self._immediately:
+            self._call()
+        while not self._stopping.wait(self.period_s):
+            self._call()
+
+    def _call(self) -> None:
+        try:
+            self._fn()
+        except Exception:
+            if not self._stopping.is_set():  # errors while the app stops are expected, not news
+                log.exception("background loop %r failed; it keeps running", self.name)
+
+    def join(self, timeout_s: float | None = None) -> bool:
+        """True once the thread has ended (call after setting the stop event)."""
+        if self._thread.ident is not None:
+            self._thread.join(timeout_s)
+        return not self._thread.is_alive()
+
+    @property
+    def alive(self) -> bool:
+        return self._thread.is_alive()
+
+
+def every(period_s: float, fn: Callable[[], object], *, name: str, stopping: threading.Event,
+          immediately: bool = False) -> Loop:
+    """Start a loop that calls `fn` every `period_s` (first right away with `immediately`)."""
+    return Loop(name, period_s, fn, stopping, immediately=immediately).start()
