@@ -40,7 +40,7 @@ class Setting:
     choices: tuple[str, ...] | None = None
 
 
-_TOPIC_RE = re.compile(r"^/?[A-Za-z_~{][A-Za-z0-9_{}~]*(/[A-Za-z_{][A-Za-z0-9_{}]*)*$")
+TOPIC_PATTERN = re.compile(r"^/?[A-Za-z_~{][A-Za-z0-9_{}~]*(/[A-Za-z_{][A-Za-z0-9_{}]*)*$")
 
 SETTINGS: tuple[Setting, ...] = (
     # --- process and ROS node ---
@@ -244,7 +244,7 @@ def _check(setting: Setting, value: Any, source: str) -> Any:
             raise fail("a non-empty string")
         if setting.choices and value not in setting.choices:
             raise fail("one of " + ", ".join(setting.choices))
-        if kind == "topic" and not _TOPIC_RE.match(value):
+        if kind == "topic" and not TOPIC_PATTERN.match(value):
             raise fail("a ROS topic name such as /cmd_vel")
         return value
     raise AssertionError(f"unknown setting kind {setting.kind}")  # a bug in SETTINGS, not user input

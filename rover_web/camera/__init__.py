@@ -22,7 +22,7 @@ from rover_web.core.leases import Closed, Leases
 from . import msgs as camera_msgs
 from rover_web.topics.msgs import publishers_best_effort, topic_types
 from rover_web.ros.typesupport import UnknownMessageType, message_class
-from rover_web.web.sse import _peer_gone as peer_gone
+from rover_web.web.connection import peer_gone
 from rover_web.web.validate import InvalidInput, topic_name
 
 log = logging.getLogger(__name__)

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-from rover_web.config import _TOPIC_RE, ConfigError
+from rover_web.config import TOPIC_PATTERN, ConfigError
 
 DEFAULT_FILE = Path(__file__).with_name("drone.toml")
 ID_RE = re.compile(r"^[a-z][a-z0-9_-]{0,31}$")
@@ -453,7 +453,7 @@ def _text(table: dict, key: str, where: _Where, default: Any = ..., allow_empty:
 
 def _topic(table: dict, where: _Where) -> str:
     topic = _text(table, "topic", where)
-    if not _TOPIC_RE.match(topic):
+    if not TOPIC_PATTERN.match(topic):
         raise where.error(f"{topic!r} is not a ROS topic name such as /control_phase", "topic")
     return topic if topic.startswith(("/", "~")) else "/" + topic
 

@@ -24,7 +24,7 @@ from . import msgs as topics_msgs
 from rover_web.camera.msgs import IMAGE_TYPES
 from rover_web.ros.typesupport import UnknownMessageType, message_class
 from rover_web.ros.typesupport import type_name as canonical_type
-from rover_web.web.sse import _peer_gone as peer_gone
+from rover_web.web.connection import peer_gone
 from .echo import EchoClosed, TopicEcho
 from rover_web.web.validate import InvalidInput, topic_name
 

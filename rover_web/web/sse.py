@@ -8,6 +8,7 @@ import time
 from flask import Blueprint, Response, request, stream_with_context
 
 from rover_web.core.state import current_rover
+from rover_web.web.connection import peer_gone
 from rover_web.events.hub import TooManyClients
 from .http import ApiError
 
@@ -16,17 +17,6 @@ bp = Blueprint("sse", __name__)
 # How often an idle stream checks that its browser is still there, so a closed tab frees its
 # thread within about a second rather than at the next failed write.
 _LIVENESS_CHECK_S = 1.0
-
-
-def _peer_gone(sock) -> bool:
-    if sock is None:
-        return False
-    try:
-        return sock.recv(1, socket.MSG_PEEK | socket.MSG_DONTWAIT) == b""
-    except BlockingIOError:
-        return False
-    except OSError:
-        return True
 
 
 def _parse_channels(raw: str, known: frozenset[str]) -> list[str]:
@@ -100,7 +90,7 @@ def events():
                 elif now - last_write >= keepalive_s:
                     yield b": keep-alive\n\n"
                     last_write = now
-                elif _peer_gone(sock):
+                elif peer_gone(sock):
                     return
 
     return Response(stream_with_context(stream()), mimetype="text/event-stream",
