@@ -8,8 +8,8 @@ want_browser=0
 [[ "${1:-}" == "--browser" ]] && want_browser=1
 
 PYTHON="${PYTHON:-python3}"
-if ! "$PYTHON" -c 'import sys; sys.exit(sys.version_info < (3, 10))' 2>/dev/null; then
-  echo "rover_web needs Python 3.10 or newer (ROS 2 Jazzy wheels are built for 3.11)" >&2
+if ! "$PYTHON" -c 'import sys; sys.exit(sys.version_info < (3, 11))' 2>/dev/null; then
+  echo "rover_web needs Python 3.11 or newer (ROS 2 Jazzy wheels are built for 3.11)" >&2
   exit 1
 fi
 

@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
-# Install everything, then run the whole test suite (unit, ROS integration, Chromium browser tests).
+# Install everything, then lint and run the whole test suite (unit, ROS integration, Chromium browser tests).
 # Extra arguments go to pytest, e.g. scripts/test.sh tests/unit -x
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/bootstrap.sh --browser
+# Lint first: it takes a second, and a red lint should not wait behind a 15-minute suite.
+echo "== ruff check"
+.venv/bin/ruff check rover_web tests bench scripts
 exec .venv/bin/python -m pytest "$@"

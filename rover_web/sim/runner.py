@@ -43,11 +43,9 @@ def run_nodes(make_nodes: Callable[[Context], list]) -> None:
     signal.signal(signal.SIGTERM, request_stop)
     names = ", ".join(n.get_name() for n in nodes)
     print(f"simulator running: {names} (domain {context.get_domain_id()}); Ctrl-C stops it", flush=True)
-    spinner = threading.Thread(target=_spin, args=(executor,), daemon=True)
+    spinner = threading.Thread(target=_spin, args=(executor, stop), daemon=True)
     spinner.start()
-    while not stop.wait(0.5):
-        if not spinner.is_alive():
-            break
+    stop.wait()  # a signal, or the spinner ending on its own; signal handlers still run while waiting
     executor.shutdown(timeout_sec=2.0)
     spinner.join(2.0)
     for node in nodes:
@@ -57,8 +55,10 @@ def run_nodes(make_nodes: Callable[[Context], list]) -> None:
     sys.stdout.flush()
 
 
-def _spin(executor) -> None:
+def _spin(executor, stop: threading.Event) -> None:
     try:
         executor.spin()
     except ExternalShutdownException:
         pass
+    finally:
+        stop.set()
