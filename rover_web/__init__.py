@@ -43,11 +43,13 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         app.config.update({k: v for k, v in test_config.items() if not k.startswith(config_module.PREFIX)})
 
     # The web layer first (every route's protection), then the CLI commands: those are registered
-    # before, and without, the ROS node, so `flask tiles fetch` never joins the ROS graph.
-    from rover_web import basemap
+    # before, and without, the ROS node, so `flask tiles fetch` or `flask users add` never joins
+    # the ROS graph.
+    from rover_web import auth, basemap
     from rover_web.web import http
 
     http.init_app(app)
+    auth.init_cli(app)
     basemap.init_cli(app)
     if process.is_reloader_watcher():
         log.warning("reloader watcher process: the ROS node starts in the serving child only")
@@ -77,10 +79,12 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
                       broadcaster=Broadcaster(hub, settings["ROVER_WEB_SSE_KEEPALIVE_S"]))
         rover.on_shutdown(rover.db.close)
         app.extensions[EXTENSION] = rover
+        auth.init_app(app, rover)  # first: every route after it is checked for sign-in and role
         # Features, in dashboard order of their cards; each registers its routes, channels,
         # subscriptions and panels.
         telemetry.init_app(app, rover)
         teleop.init_app(app, rover)
+        basemap.init_app(app, rover)
         waypoints.init_app(app, rover)
         scan_the_code.init_app(app, rover)
         panels.init_app(app, rover)

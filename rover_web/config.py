@@ -58,6 +58,15 @@ SETTINGS: tuple[Setting, ...] = (
             "Host header values accepted (port ignored; '.example.org' matches subdomains); guards DNS rebinding"),
     Setting("ALLOWED_ORIGINS", [], "list",
             "extra Origins (scheme://host:port) allowed to change state, besides the page's own origin"),
+    # --- sign-in and HTTPS ---
+    Setting("AUTH", "auto", "str",
+            "sign-in: auto (required unless the server listens on loopback only), required, or off",
+            choices=("auto", "required", "off")),
+    Setting("SECRET_KEY", None, "optional_str",
+            "signs session cookies; unset: a random key kept in the instance folder (secret_key)"),
+    Setting("TLS_CERT", None, "optional_str",
+            "PEM certificate for HTTPS (the demo and gunicorn.conf.py); `flask tls self-signed` writes one"),
+    Setting("TLS_KEY", None, "optional_str", "PEM private key that goes with ROVER_WEB_TLS_CERT"),
     Setting("MAX_BODY_BYTES", 262144, "int", "largest request body accepted (413 beyond)", 1024, 64 * 1024 * 1024),
     # --- live events and link health ---
     Setting("SSE_KEEPALIVE_S", 10.0, "float", "seconds between SSE keep-alive comments (at most 15)", 0.05, 15),

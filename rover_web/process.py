@@ -87,3 +87,17 @@ def stop_with_process(rover) -> None:
 
         handler._rover_web = True  # type: ignore[attr-defined]
         signal.signal(signum, handler)
+
+
+def listen_hosts(settings) -> list[str]:
+    """The addresses the server will listen on, as far as the app can know before it serves.
+
+    `flask run --host` is read from its command line; the demo and gunicorn.conf.py bind to
+    ROVER_WEB_HOST (gunicorn.conf.py copies a `-b` given on gunicorn's command line into it).
+    """
+    import click
+
+    ctx = click.get_current_context(silent=True)
+    if ctx is not None and ctx.info_name == "run" and "host" in ctx.params:
+        return [ctx.params["host"] or "127.0.0.1"]
+    return [h.strip() for h in str(settings["ROVER_WEB_HOST"]).split(",") if h.strip()]

@@ -41,7 +41,7 @@ def json_body(required: bool = True) -> dict:
     return body
 
 
-def _wants_json(req: Request) -> bool:
+def wants_json(req: Request) -> bool:
     return req.path.startswith(JSON_PREFIXES) or req.method != "GET" or req.accept_mimetypes.best == "application/json"
 
 
@@ -68,6 +68,49 @@ def origin_allowed(origin: str, host: str, allowed: list[str]) -> bool:
     return origin.rstrip("/") in {a.rstrip("/") for a in allowed}
 
 
+FORM_TYPES = ("application/x-www-form-urlencoded", "multipart/form-data")
+
+# What every response may load and who may frame it. The pages load scripts, styles, images and
+# fonts from this server only; MapLibre builds its worker from a blob: URL and draws tiles from
+# blob: and data: images. Inline styles stay allowed for the templates' style="--c: ..." values.
+CONTENT_SECURITY_POLICY = "; ".join([
+    "default-src 'self'",
+    "script-src 'self'",
+    "style-src 'self' 'unsafe-inline'",
+    "img-src 'self' data: blob:",
+    "worker-src 'self' blob:",
+    "child-src 'self' blob:",
+    "connect-src 'self'",
+    "object-src 'none'",
+    "base-uri 'self'",
+    "form-action 'self'",
+    "frame-ancestors 'none'",
+])
+SECURITY_HEADERS = {
+    "Content-Security-Policy": CONTENT_SECURITY_POLICY,
+    "X-Frame-Options": "DENY",
+    "X-Content-Type-Options": "nosniff",
+    "Referrer-Policy": "same-origin",
+}
+
+
+def accepts_form(view):
+    """Mark a view that takes an HTML form's POST (the sign-in form) besides JSON."""
+    view.accepts_form = True
+    return view
+
+
+def _view_accepts_form() -> bool:
+    view = current_app.view_functions.get(request.endpoint) if request.endpoint else None
+    return bool(getattr(view, "accepts_form", False))
+
+
+def _security_headers(response):
+    for name, value in SECURITY_HEADERS.items():
+        response.headers.setdefault(name, value)
+    return response
+
+
 def _guard():
     config = current_app.config
     host = request.environ.get("HTTP_HOST", "")
@@ -84,7 +127,8 @@ def _guard():
     if request.content_length is not None and request.content_length > limit:
         # Refuse before routing or reading, whatever the route does with its body.
         return error_response(413, "request_entity_too_large", f"request body is larger than {limit} bytes")
-    if request.method in ("POST", "PUT", "PATCH") and request.mimetype != "application/json":
+    if (request.method in ("POST", "PUT", "PATCH") and request.mimetype != "application/json"
+            and not (request.mimetype in FORM_TYPES and _view_accepts_form())):
         return error_response(415, "unsupported_media_type",
                               "send the body as JSON with the header Content-Type: application/json")
     return None
@@ -92,6 +136,7 @@ def _guard():
 
 def init_app(app: Flask) -> None:
     app.before_request(_guard)
+    app.after_request(_security_headers)
 
     @app.errorhandler(ApiError)
     def _api_error(exc: ApiError):
@@ -99,7 +144,7 @@ def init_app(app: Flask) -> None:
 
     @app.errorhandler(HTTPException)
     def _http_error(exc: HTTPException):
-        if not _wants_json(request):
+        if not wants_json(request):
             return exc
         code = (exc.name or "error").lower().replace(" ", "_")
         message = exc.description or exc.name

@@ -1,0 +1,202 @@
+"""Users, their roles and their API tokens, kept in the app's SQLite database.
+
+Passwords are hashed with Argon2id (argon2-cffi: memory-hard, salted, parameters stored in the hash,
+so they can be raised later and old hashes re-hashed on sign-in). API tokens are random 256-bit
+strings shown once; only their SHA-256 is stored: a token is already high-entropy, so a slow hash
+would only cost every curl request time without adding strength.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import hmac
+import re
+import secrets
+import sqlite3
+import time
+from dataclasses import dataclass
+
+from argon2 import PasswordHasher
+from argon2.exceptions import InvalidHashError, VerificationError
+
+ROLES = ("viewer", "operator", "admin")
+NAME_PATTERN = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.@-]{0,39}\Z")
+MIN_PASSWORD_LEN = 8
+MAX_PASSWORD_LEN = 1024  # argon2 takes any length; a megabyte "password" would only cost CPU
+TOKEN_PREFIX = "rwt_"
+
+ACCOUNTS_DDL = """
+CREATE TABLE IF NOT EXISTS auth_users (
+    name TEXT PRIMARY KEY CHECK (length(name) BETWEEN 1 AND 40),
+    role TEXT NOT NULL CHECK (role IN ('viewer', 'operator', 'admin')),
+    password_hash TEXT NOT NULL,
+    created_at REAL NOT NULL
+);
+CREATE TABLE IF NOT EXISTS auth_tokens (
+    id INTEGER PRIMARY KEY AUTOINCREMENT,
+    user_name TEXT NOT NULL REFERENCES auth_users(name) ON DELETE CASCADE,
+    token_sha256 TEXT NOT NULL UNIQUE,
+    label TEXT NOT NULL DEFAULT '' CHECK (length(label) <= 80),
+    created_at REAL NOT NULL,
+    revoked_at REAL
+)
+"""
+
+# A hash of a password nobody has, checked when the name is unknown, so that an unknown name
+# takes as long to refuse as a wrong password (no user enumeration by timing).
+_hasher = PasswordHasher()
+_DUMMY_HASH = _hasher.hash(secrets.token_hex(16))
+
+
+class AccountError(ValueError):
+    """A request about accounts that cannot be done; the message says why."""
+
+    def __init__(self, message: str, code: str = "bad_value"):
+        super().__init__(message)
+        self.code = code
+
+
+@dataclass(frozen=True)
+class User:
+    name: str
+    role: str
+
+    def may(self, role: str) -> bool:
+        """True when this user's role includes `role` (admin > operator > viewer)."""
+        return ROLES.index(self.role) >= ROLES.index(role)
+
+
+def check_name(name: str) -> str:
+    if not isinstance(name, str) or not NAME_PATTERN.match(name):
+        raise AccountError("a user name is 1-40 letters, digits, '_', '.', '@' or '-', starting with a letter "
+                           "or digit", "bad_name")
+    return name
+
+
+def check_role(role: str) -> str:
+    if role not in ROLES:
+        raise AccountError(f"role must be one of {', '.join(ROLES)}", "bad_role")
+    return role
+
+
+def check_password(password: str) -> str:
+    if not isinstance(password, str) or not MIN_PASSWORD_LEN <= len(password) <= MAX_PASSWORD_LEN:
+        raise AccountError(f"a password is {MIN_PASSWORD_LEN} to {MAX_PASSWORD_LEN} characters", "bad_password")
+    return password
+
+
+def token_digest(token: str) -> str:
+    return hashlib.sha256(token.encode("utf-8", "surrogatepass")).hexdigest()
+
+
+class Accounts:
+    def __init__(self, db):
+        self._db = db
+        db.ensure_schema(ACCOUNTS_DDL)
+
+    # --- users ---
+
+    def add_user(self, name: str, role: str, password: str) -> User:
+        check_name(name), check_role(role), check_password(password)
+        password_hash = _hasher.hash(password)
+        try:
+            with self._db.transaction() as conn:
+                conn.execute("INSERT INTO auth_users (name, role, password_hash, created_at) VALUES (?, ?, ?, ?)",
+                             (name, role, password_hash, time.time()))
+        except sqlite3.IntegrityError:
+            raise AccountError(f"user {name!r} exists already", "user_exists") from None
+        return User(name, role)
+
+    def users(self) -> list[dict]:
+        rows = self._db.connection().execute(
+            "SELECT u.name, u.role, u.created_at, "
+            "(SELECT count(*) FROM auth_tokens t WHERE t.user_name = u.name AND t.revoked_at IS NULL) AS tokens "
+            "FROM auth_users u ORDER BY u.name").fetchall()
+        return [dict(row) for row in rows]
+
+    def count(self) -> int:
+        return self._db.connection().execute("SELECT count(*) FROM auth_users").fetchone()[0]
+
+    def get(self, name: str) -> User | None:
+        row = self._db.connection().execute("SELECT name, role FROM auth_users WHERE name = ?", (name,)).fetchone()
+        return User(row["name"], row["role"]) if row else None
+
+    def set_role(self, name: str, role: str) -> User:
+        check_role(role)
+        with self._db.transaction() as conn:
+            if conn.execute("UPDATE auth_users SET role = ? WHERE name = ?", (role, name)).rowcount == 0:
+                raise AccountError(f"no user {name!r}", "no_such_user")
+        return User(name, role)
+
+    def set_password(self, name: str, password: str) -> None:
+        check_password(password)
+        password_hash = _hasher.hash(password)
+        with self._db.transaction() as conn:
+            if conn.execute("UPDATE auth_users SET password_hash = ? WHERE name = ?",
+                            (password_hash, name)).rowcount == 0:
+                raise AccountError(f"no user {name!r}", "no_such_user")
+
+    def remove_user(self, name: str) -> None:
+        """Removes the user and, with them, their tokens (ON DELETE CASCADE)."""
+        with self._db.transaction() as conn:
+            if conn.execute("DELETE FROM auth_users WHERE name = ?", (name,)).rowcount == 0:
+                raise AccountError(f"no user {name!r}", "no_such_user")
+
+    def authenticate(self, name: str, password: str) -> User | None:
+        """The user, if the password is theirs; None otherwise (same time either way)."""
+        if not isinstance(name, str) or not isinstance(password, str) or len(password) > MAX_PASSWORD_LEN:
+            return None
+        row = self._db.connection().execute(
+            "SELECT name, role, password_hash FROM auth_users WHERE name = ?", (name,)).fetchone()
+        try:
+            _hasher.verify(row["password_hash"] if row else _DUMMY_HASH, password)
+        except (VerificationError, InvalidHashError):
+            return None
+        if row is None:
+            return None
+        if _hasher.check_needs_rehash(row["password_hash"]):
+            self._rehash(name, password)
+        return User(row["name"], row["role"])
+
+    def _rehash(self, name: str, password: str) -> None:
+        with self._db.transaction() as conn:
+            conn.execute("UPDATE auth_users SET password_hash = ? WHERE name = ?", (_hasher.hash(password), name))
+
+    # --- API tokens ---
+
+    def create_token(self, user_name: str, label: str = "") -> tuple[int, str]:
+        """A new token for the user: (its id, the token). The token is not stored and cannot be shown again."""
+        if len(label) > 80:
+            raise AccountError("a token label is at most 80 characters", "bad_label")
+        token = TOKEN_PREFIX + secrets.token_urlsafe(32)
+        with self._db.transaction() as conn:
+            if conn.execute("SELECT 1 FROM auth_users WHERE name = ?", (user_name,)).fetchone() is None:
+                raise AccountError(f"no user {user_name!r}", "no_such_user")
+            cursor = conn.execute(
+                "INSERT INTO auth_tokens (user_name, token_sha256, label, created_at) VALUES (?, ?, ?, ?)",
+                (user_name, token_digest(token), label, time.time()))
+        return cursor.lastrowid, token
+
+    def tokens(self) -> list[dict]:
+        rows = self._db.connection().execute(
+            "SELECT id, user_name AS user, label, created_at, revoked_at FROM auth_tokens ORDER BY id").fetchall()
+        return [dict(row) for row in rows]
+
+    def revoke_token(self, token_id: int) -> None:
+        with self._db.transaction() as conn:
+            row = conn.execute("SELECT revoked_at FROM auth_tokens WHERE id = ?", (token_id,)).fetchone()
+            if row is None:
+                raise AccountError(f"no token with id {token_id}", "no_such_token")
+            if row["revoked_at"] is None:
+                conn.execute("UPDATE auth_tokens SET revoked_at = ? WHERE id = ?", (time.time(), token_id))
+
+    def user_for_token(self, token: str) -> User | None:
+        if not isinstance(token, str) or not token.startswith(TOKEN_PREFIX) or len(token) > 100:
+            return None
+        digest = token_digest(token)
+        row = self._db.connection().execute(
+            "SELECT u.name, u.role, t.token_sha256 FROM auth_tokens t JOIN auth_users u ON u.name = t.user_name "
+            "WHERE t.token_sha256 = ? AND t.revoked_at IS NULL", (digest,)).fetchone()
+        if row is None or not hmac.compare_digest(row["token_sha256"], digest):
+            return None
+        return User(row["name"], row["role"])

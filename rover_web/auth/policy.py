@@ -1,0 +1,63 @@
+"""Who may do what, and when sign-in is required. Pure Python: decided here, enforced by routes.py.
+
+Roles, each including the ones below it:
+  viewer    every GET (pages, APIs, SSE, camera, topic echo) and ENGAGING the e-stop: anyone who
+            sees danger must be able to stop the robot.
+  operator  also everything that moves or commands the robot: driving (the teleop WebSocket and
+            REST), taking over, releasing the e-stop, LiveMap goals, waypoint writes, the mission
+            send, panel unlock and commands.
+  admin     also users and API tokens.
+The default is closed: a state-changing route nobody listed needs the operator role.
+"""
+
+from __future__ import annotations
+
+import ipaddress
+from collections.abc import Iterable
+
+from .accounts import ROLES
+
+MODES = ("auto", "required", "off")
+READ_METHODS = frozenset({"GET", "HEAD", "OPTIONS"})
+# Reachable without signing in: the sign-in form itself and the files it needs.
+PUBLIC_ENDPOINTS = frozenset({"auth.login_form", "auth.login", "static"})
+# Any signed-in user, whatever the method.
+ANY_USER_ENDPOINTS = frozenset({"auth.logout", "teleop.estop_set"})  # estop_set: the view checks release
+ADMIN_ENDPOINT_PREFIX = "auth.admin_"
+
+
+def required_role(method: str, path: str, endpoint: str | None) -> str | None:
+    """The least role a request needs; None when it needs no sign-in at all."""
+    if endpoint in PUBLIC_ENDPOINTS:
+        return None
+    if endpoint and endpoint.startswith(ADMIN_ENDPOINT_PREFIX):
+        return "admin"
+    if path.startswith("/ws/"):
+        return "operator"  # the teleop socket is how an operator drives
+    if endpoint in ANY_USER_ENDPOINTS or method in READ_METHODS:
+        return "viewer"
+    return "operator"
+
+
+def role_allows(role: str, needed: str) -> bool:
+    return ROLES.index(role) >= ROLES.index(needed)
+
+
+def is_loopback(host: str) -> bool:
+    host = host.strip().strip("[]")
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False  # a name, 0.0.0.0, :: or a unix socket: assume others can reach it
+
+
+def sign_in_required(mode: str, listen_hosts: Iterable[str]) -> bool:
+    """auto: required unless every address the server listens on is loopback."""
+    if mode == "required":
+        return True
+    if mode == "off":
+        return False
+    hosts = [h for h in listen_hosts if h]
+    return not hosts or not all(is_loopback(h) for h in hosts)

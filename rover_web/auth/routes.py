@@ -1,0 +1,210 @@
+"""Sign-in pages and API (/login, /logout, /api/me), the admin API for users and tokens, and the
+check every request passes before its view runs."""
+
+from __future__ import annotations
+
+from flask import Blueprint, jsonify, redirect, render_template, request, url_for
+from flask_login import current_user, login_user, logout_user
+
+from rover_web.core.state import current_feature
+from rover_web.web.http import ApiError, accepts_form, error_response, json_body, wants_json
+from rover_web.web.validate import InvalidInput, only_keys, text
+
+from .accounts import AccountError
+from .identity import SignedIn
+from .policy import required_role, role_allows
+from .service import AuthService
+
+bp = Blueprint("auth", __name__)
+
+
+def _service() -> AuthService:
+    return current_feature(AuthService)
+
+
+@bp.before_app_request
+def check_access():
+    auth = _service()
+    if not auth.required:
+        return None
+    needed = required_role(request.method, request.path, request.endpoint)
+    if needed is None:
+        return None
+    if not current_user.is_authenticated:
+        if request.method == "GET" and not wants_json(request):
+            return redirect(url_for("auth.login_form", next=request.full_path.rstrip("?")))
+        response = error_response(401, "unauthenticated",
+                                  "sign in at /login, or send the header Authorization: Bearer <token>")
+        response.headers["WWW-Authenticate"] = 'Bearer realm="rover_web"'
+        return response
+    if not role_allows(current_user.role, needed):
+        return _forbidden(needed)
+    return None
+
+
+def _forbidden(needed: str):
+    return error_response(403, "forbidden", f"this needs the {needed} role; {current_user.name} is a {current_user.role}")
+
+
+def require(role: str) -> None:
+    """For views whose rule depends on the request body (releasing the e-stop needs an operator)."""
+    if _service().required and not role_allows(current_user.role, role):
+        raise ApiError(403, "forbidden", f"this needs the {role} role; {current_user.name} is a {current_user.role}")
+
+
+def _safe_next(target: str | None) -> str:
+    # Only a path on this server: never an open redirect to another site.
+    if target and target.startswith("/") and not target.startswith("//") and "\\" not in target:
+        return target
+    return "/"
+
+
+# --- sign-in ---
+
+@bp.get("/login")
+def login_form():
+    if current_user.is_authenticated:
+        return redirect(_safe_next(request.args.get("next")))
+    return render_template("login.html", next=_safe_next(request.args.get("next")), error=None, username="")
+
+
+@bp.post("/login")
+@accepts_form
+def login():
+    auth = _service()
+    as_json = request.mimetype == "application/json"
+    fields = json_body() if as_json else request.form
+    username, password = fields.get("username"), fields.get("password")
+    next_path = _safe_next(fields.get("next") if not as_json else None)
+    if not isinstance(username, str) or not isinstance(password, str) or not username or not password:
+        return _login_refused(as_json, 400, "missing_field", "enter a user name and a password", "", next_path)
+    username = username.strip()[:80]
+    wait_s = auth.throttle.retry_after_s(username)
+    if wait_s > 0:
+        response = _login_refused(as_json, 429, "too_many_attempts",
+                                  f"too many failed sign-ins for {username!r}: try again in {wait_s:.0f} s",
+                                  username, next_path)
+        response.headers["Retry-After"] = str(int(wait_s + 0.999))
+        return response
+    user = auth.accounts.authenticate(username, password)
+    if user is None:
+        auth.throttle.failed(username)
+        return _login_refused(as_json, 401, "bad_credentials", "wrong user name or password", username, next_path)
+    auth.throttle.succeeded(username)
+    login_user(SignedIn(user.name, user.role, "session"))
+    if as_json:
+        return jsonify(user=user.name, role=user.role)
+    return redirect(next_path, 303)
+
+
+def _login_refused(as_json: bool, status: int, code: str, message: str, username: str, next_path: str):
+    if as_json:
+        return error_response(status, code, message)
+    html = render_template("login.html", next=next_path, error=message, username=username)
+    return html, status, {"Content-Type": "text/html; charset=utf-8"}
+
+
+@bp.post("/logout")
+@accepts_form
+def logout():
+    logout_user()
+    if request.mimetype == "application/json" or request.accept_mimetypes.best == "application/json":
+        return jsonify(signed_out=True)
+    return redirect(url_for("auth.login_form"), 303)
+
+
+@bp.get("/api/me")
+def me():
+    auth = _service()
+    if not auth.required:
+        return jsonify(user=None, role="admin", sign_in=False, via=None)
+    return jsonify(user=current_user.name, role=current_user.role, sign_in=True, via=current_user.via)
+
+
+# --- users and tokens (admin) ---
+
+def _account_error(exc: AccountError):
+    status = 404 if exc.code.startswith("no_such") else 409 if exc.code == "user_exists" else 400
+    return error_response(status, exc.code, str(exc))
+
+
+@bp.get("/api/users")
+def admin_list_users():
+    return jsonify(users=_service().accounts.users())
+
+
+@bp.post("/api/users")
+def admin_add_user():
+    body = json_body()
+    try:
+        only_keys(body, {"name", "role", "password"})
+        name, role = text(body, "name", max_len=40), text(body, "role", max_len=20)
+        password = text(body, "password", max_len=1024)
+        user = _service().accounts.add_user(name, role, password)
+    except InvalidInput as exc:
+        raise ApiError(400, exc.code, str(exc)) from None
+    except AccountError as exc:
+        return _account_error(exc)
+    return jsonify(name=user.name, role=user.role), 201
+
+
+@bp.patch("/api/users/<name>")
+def admin_update_user(name: str):
+    body = json_body()
+    accounts = _service().accounts
+    try:
+        only_keys(body, {"role", "password"})
+        if not body:
+            raise InvalidInput("send 'role', 'password' or both", "missing_field")
+        role = text(body, "role", max_len=20, default=None)
+        password = text(body, "password", max_len=1024, default=None)
+        if accounts.get(name) is None:
+            raise AccountError(f"no user {name!r}", "no_such_user")
+        if role is not None:
+            accounts.set_role(name, role)
+        if password is not None:
+            accounts.set_password(name, password)
+    except InvalidInput as exc:
+        raise ApiError(400, exc.code, str(exc)) from None
+    except AccountError as exc:
+        return _account_error(exc)
+    user = accounts.get(name)
+    return jsonify(name=user.name, role=user.role)
+
+
+@bp.delete("/api/users/<name>")
+def admin_remove_user(name: str):
+    try:
+        _service().accounts.remove_user(name)
+    except AccountError as exc:
+        return _account_error(exc)
+    return jsonify(removed=name)
+
+
+@bp.get("/api/tokens")
+def admin_list_tokens():
+    return jsonify(tokens=_service().accounts.tokens())
+
+
+@bp.post("/api/tokens")
+def admin_create_token():
+    body = json_body()
+    try:
+        only_keys(body, {"user", "label"})
+        user = text(body, "user", max_len=40)
+        label = text(body, "label", max_len=80, default="")
+        token_id, token = _service().accounts.create_token(user, label)
+    except InvalidInput as exc:
+        raise ApiError(400, exc.code, str(exc)) from None
+    except AccountError as exc:
+        return _account_error(exc)
+    return jsonify(id=token_id, user=user, token=token), 201
+
+
+@bp.delete("/api/tokens/<int:token_id>")
+def admin_revoke_token(token_id: int):
+    try:
+        _service().accounts.revoke_token(token_id)
+    except AccountError as exc:
+        return _account_error(exc)
+    return jsonify(revoked=token_id)

@@ -1,0 +1,64 @@
+"""The auth feature's per-app object: accounts, sign-in throttling, and whether sign-in is on."""
+
+from __future__ import annotations
+
+import logging
+import os
+import secrets
+from pathlib import Path
+
+from rover_web.config import ConfigError
+
+from .accounts import Accounts
+from .policy import sign_in_required
+from .throttle import LoginThrottle
+
+log = logging.getLogger(__name__)
+
+ADD_USER_HINT = "flask --app rover_web users add NAME --role admin"
+
+
+class AuthService:
+    def __init__(self, db, mode: str, listen_hosts: list[str]):
+        self.accounts = Accounts(db)
+        self.throttle = LoginThrottle(max_failures=5, window_s=60.0, lockout_s=60.0)
+        self.mode = mode
+        self.listen_hosts = listen_hosts
+        self.required = sign_in_required(mode, listen_hosts)
+
+    def check_startable(self) -> None:
+        """Refuse to serve a network with sign-in required and nobody able to sign in."""
+        if mode_note := self.startup_note():
+            log.warning(mode_note)
+        if self.required and self.accounts.count() == 0:
+            where = ", ".join(self.listen_hosts) or "an address that is not loopback"
+            other_way = ", or listen on 127.0.0.1 only" if self.mode == "auto" else ""
+            raise ConfigError(f"sign-in is required (ROVER_WEB_AUTH={self.mode}, listening on {where}) but no user "
+                              f"exists: add one with `{ADD_USER_HINT}`{other_way}")
+
+    def startup_note(self) -> str | None:
+        if self.mode == "off":
+            return ("ROVER_WEB_AUTH=off: anyone who can reach this server can drive the robot, take control "
+                    "and release the e-stop")
+        return None
+
+
+def secret_key(configured: str | None, instance_path: str) -> str:
+    """The configured key, or one made once and kept (mode 0600) in the instance folder, so sessions
+    survive a restart."""
+    if configured:
+        return configured
+    path = Path(instance_path) / "secret_key"
+    try:
+        return path.read_text().strip()
+    except FileNotFoundError:
+        pass
+    path.parent.mkdir(parents=True, exist_ok=True)
+    key = secrets.token_hex(32)
+    try:
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+    except FileExistsError:  # another process made it first: use theirs
+        return path.read_text().strip()
+    with os.fdopen(fd, "w") as f:
+        f.write(key)
+    return key
