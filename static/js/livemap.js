@@ -4,6 +4,7 @@
 // The page renders with its data in #livemap-data; the pose, goal, plan and live_map channels
 // keep it current. window.liveMapState mirrors what is drawn, for tests and for curious operators.
 
+import { api, ApiError } from './api.js';
 import { on, onServerState } from './live.js';
 
 const data = JSON.parse(document.getElementById('livemap-data').textContent);
@@ -367,20 +368,18 @@ async function sendGoal(x, y, yaw, what) {
   S.lastGoal = { request: body, status: 'sending' };
   message(`Sending ${what}…`);
   try {
-    const response = await fetch(`/api/maps/${encodeURIComponent(S.map)}/goal`, {
-      method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body),
-    });
-    const reply = await response.json().catch(() => ({}));
-    S.lastGoal = { request: body, status: response.status, reply };
-    if (response.ok) {
-      S.goal = { x: reply.goal.x, y: reply.goal.y, yaw: reply.goal.yaw, frame_id: reply.goal.frame_id };
-      message(`Goal sent: ${what} (${fmt(x)}, ${fmt(y)} m, ${degrees(yaw)}).`);
-    } else {
-      message(`Goal refused: ${reply.message || response.statusText}`, true);
-    }
+    const reply = await api('POST', `/api/maps/${encodeURIComponent(S.map)}/goal`, body);
+    S.lastGoal = { request: body, status: 200, reply };  // api() resolves only on 2xx; this route answers 200
+    S.goal = { x: reply.goal.x, y: reply.goal.y, yaw: reply.goal.yaw, frame_id: reply.goal.frame_id };
+    message(`Goal sent: ${what} (${fmt(x)}, ${fmt(y)} m, ${degrees(yaw)}).`);
   } catch (err) {
-    S.lastGoal = { request: body, status: 'failed' };
-    message('Goal not sent: the server did not answer.', true);
+    if (err instanceof ApiError) {
+      S.lastGoal = { request: body, status: err.status, reply: err.reply || {} };
+      message(`Goal refused: ${err.message}`, true);
+    } else {
+      S.lastGoal = { request: body, status: 'failed' };
+      message('Goal not sent: the server did not answer.', true);
+    }
   }
   requestDraw();
 }
