@@ -33,10 +33,11 @@ export async function errorFrom(response) {
 }
 
 // body: an object to send as JSON, or a string that already is JSON text (an uploaded file),
-// sent as it is so the server, not the page, judges it.
+// sent as it is so the server, not the page, judges it. null, like undefined, sends no body:
+// fetch refuses any body on a GET.
 export async function api(method, url, body) {
   const init = { method, headers: { Accept: 'application/json' } };
-  if (body !== undefined) {
+  if (body !== undefined && body !== null) {
     init.headers['Content-Type'] = 'application/json';
     init.body = typeof body === 'string' ? body : JSON.stringify(body);
   }
