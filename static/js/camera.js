@@ -2,6 +2,8 @@
 // while the tab is hidden, so the server can remove its subscription, and it is only requested
 // for topics the ROS graph lists as images, so a missing camera is a message, not a failed request.
 
+import { api } from './api.js';
+
 const card = document.getElementById('camera-card');
 const STORAGE_KEY = 'rover_web.camera.topic';
 const RECHECK_MS = 3000;
@@ -56,14 +58,11 @@ if (card) {
 
   async function refreshTopics() {
     try {
-      const res = await fetch('/api/topics', { headers: { Accept: 'application/json' } });
-      if (res.ok) {
-        const graph = await res.json();
-        const images = graph.topics.filter((t) => t.types.some((type) => IMAGE_TYPES.has(type)));
-        imageTopics = new Set(images.map((t) => t.name));
-        for (const t of images) ensureOption(t.name);
-      }
-    } catch { /* the server is away; the link-health pill says so */ }
+      const graph = await api('GET', '/api/topics');
+      const images = graph.topics.filter((t) => t.types.some((type) => IMAGE_TYPES.has(type)));
+      imageTopics = new Set(images.map((t) => t.name));
+      for (const t of images) ensureOption(t.name);
+    } catch { /* the server is away or refused; the link-health pill says so */ }
     start();
   }
 

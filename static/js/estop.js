@@ -1,5 +1,6 @@
 // The e-stop in every page's header. Engaging is one click and is retried until the server
 // confirms it; releasing is a separate button, so a double click can never release.
+import { api } from './api.js';
 import { on } from './live.js';
 import { operatorName } from './operator.js';
 
@@ -17,16 +18,7 @@ function show(engaged, unconfirmed = false) {
   document.body.classList.toggle('estop-engaged', engaged);
 }
 
-async function post(engaged) {
-  const response = await fetch('/api/estop', {
-    method: 'POST',
-    headers: { 'Content-Type': 'application/json' },
-    body: JSON.stringify({ engaged, by: operatorName() }),
-  });
-  const body = await response.json();
-  if (!response.ok) throw new Error(body.message || `HTTP ${response.status}`);
-  return body;
-}
+const post = (engaged) => api('POST', '/api/estop', { engaged, by: operatorName() });
 
 async function engage(attempt = 0) {
   clearTimeout(retryTimer);

@@ -1,6 +1,7 @@
 // Mission control panels: keeps the server-rendered panels (and the dashboard summary) current
 // from the `panel` and `panel_log` channels, and sends commands. The server decides what is
 // allowed; the page only mirrors it so an operator sees why a button is disabled.
+import { api, ApiError } from './api.js';
 import { on } from './live.js';
 
 const LIGHT_TEXT = { green: 'not running', red: 'running', unknown: 'unknown' };
@@ -105,17 +106,11 @@ function say(root, text, isError) {
 
 async function post(root, path, body) {
   const url = `/api/panels/${encodeURIComponent(root.dataset.panel)}/${path}`;
-  let response;
+  let reply;
   try {
-    response = await fetch(url, { method: 'POST', headers: { 'Content-Type': 'application/json' },
-      body: JSON.stringify(body || {}) });
-  } catch {
-    say(root, 'The server cannot be reached: nothing was sent.', true);
-    return null;
-  }
-  const reply = await response.json().catch(() => ({}));
-  if (!response.ok) {
-    say(root, reply.message || `refused (${response.status})`, true);
+    reply = (await api('POST', url, body || {})) || {};
+  } catch (err) {
+    say(root, err instanceof ApiError ? err.message : 'The server cannot be reached: nothing was sent.', true);
     return null;
   }
   if (reply.log) addLogEntry(reply.log);

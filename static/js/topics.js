@@ -1,6 +1,7 @@
 // Topic browser: the live topic list (`topics` channel) and an echo of the chosen topic
 // (its own EventSource on /api/topics/echo, closed when another topic is chosen or the tab is
 // hidden, so the server removes the subscription when nobody looks).
+import { errorFrom } from './api.js';
 import { on } from './live.js';
 
 const body = document.getElementById('topics-body');
@@ -84,13 +85,13 @@ function closeEcho() {
 }
 
 async function explainFailure(url) {
-  // EventSource hides the response; ask once more to show the server's reason.
+  // EventSource hides the response; ask once more to show the server's reason. Its own fetch,
+  // not api(): on success the answer is the event stream itself, which must not be read to its end.
   const abort = new AbortController();
   try {
     const res = await fetch(url, { signal: abort.signal, headers: { Accept: 'application/json' } });
     if (!res.ok) {
-      const err = await res.json().catch(() => ({ message: res.statusText }));
-      showError(err.message || `error ${res.status}`);
+      showError((await errorFrom(res)).message);
       return;
     }
   } catch { /* server away */ } finally { abort.abort(); }

@@ -2,6 +2,7 @@
 // mission list, and the robot's fix with its track. The server owns the mission: every edit is an
 // HTTP call, and what is drawn is whatever the `waypoints` channel (or a fresh GET) says, newest
 // revision wins. Untrusted text (labels) only ever goes through textContent.
+import { api } from './api.js';
 import { on } from './live.js';
 
 const el = document.getElementById('wp-map');
@@ -13,19 +14,6 @@ function fmtLatLng(lat, lng) {
   const ns = lat >= 0 ? 'N' : 'S';
   const ew = lng >= 0 ? 'E' : 'W';
   return `${Math.abs(lat).toFixed(7)}° ${ns}, ${Math.abs(lng).toFixed(7)}° ${ew}`;
-}
-
-async function api(method, url, body) {
-  const init = { method, headers: { Accept: 'application/json' } };
-  if (body !== undefined) {
-    init.headers['Content-Type'] = 'application/json';
-    init.body = typeof body === 'string' ? body : JSON.stringify(body);
-  }
-  const res = await fetch(url, init);
-  let data = null;
-  try { data = await res.json(); } catch { /* an empty or non-JSON answer */ }
-  if (!res.ok) throw new Error((data && data.message) || `${res.status} ${res.statusText}`);
-  return data;
 }
 
 // --- the map's own style: nothing is fetched unless a local basemap is installed ---
