@@ -11,6 +11,17 @@ worker_class = "gthread"
 threads = 64  # each open page holds one thread (its SSE stream) plus one per WebSocket
 timeout = 0  # event streams are long-lived by design
 graceful_timeout = 5
+# HTTPS: the same certificate and key the demo uses (`flask --app rover_web tls self-signed` writes a pair).
+certfile = os.environ.get("ROVER_WEB_TLS_CERT") or None
+keyfile = os.environ.get("ROVER_WEB_TLS_KEY") or None
+
+
+def on_starting(server):
+    # Whether sign-in is required (ROVER_WEB_AUTH=auto) depends on where the server listens; a
+    # `-b` on gunicorn's command line overrides `bind` above, so tell the app what was chosen.
+    hosts = [address.rsplit(":", 1)[0].strip("[]") if not address.startswith("unix:") else address
+             for address in server.cfg.bind]
+    os.environ["ROVER_WEB_HOST"] = ",".join(hosts)
 
 
 def worker_int(worker):

@@ -286,4 +286,6 @@ def load(test_config: Mapping[str, Any] | None = None, environ: Mapping[str, str
     _apply(merged, {k: v for k, v in environ.items() if k.startswith(PREFIX)}, "environment", _from_text)
     if test_config:
         _apply(merged, test_config, "create_app(test_config)", None)
+    if bool(merged[PREFIX + "TLS_CERT"]) != bool(merged[PREFIX + "TLS_KEY"]):
+        raise ConfigError("ROVER_WEB_TLS_CERT and ROVER_WEB_TLS_KEY go together: set both for HTTPS, or neither")
     return merged

@@ -26,18 +26,22 @@ def main(argv: list[str] | None = None) -> int:
     if args.domain_id is not None:
         os.environ["ROS_DOMAIN_ID"] = str(args.domain_id)
     os.environ.setdefault("ROS_DOMAIN_ID", "42")
+    if args.host:  # before create_app: whether sign-in is needed depends on where we listen
+        os.environ["ROVER_WEB_HOST"] = args.host
 
     from rover_web import create_app
 
     app = create_app()
     config = app.config
-    host = args.host or config["ROVER_WEB_HOST"]
+    host = config["ROVER_WEB_HOST"]
     port = args.port or config["ROVER_WEB_PORT"]
+    tls = (config["ROVER_WEB_TLS_CERT"], config["ROVER_WEB_TLS_KEY"]) if config["ROVER_WEB_TLS_CERT"] else None
+    scheme = "https" if tls else "http"
     sim = subprocess.Popen([sys.executable, "-m", "rover_web.sim", *sim_args])
-    print(f"rover_web: GUI on http://{'127.0.0.1' if host == '0.0.0.0' else host}:{port}/ "
+    print(f"rover_web: GUI on {scheme}://{'127.0.0.1' if host == '0.0.0.0' else host}:{port}/ "
           f"(ROS domain {os.environ['ROS_DOMAIN_ID']}); Ctrl-C stops the GUI and the simulator", flush=True)
     try:
-        app.run(host=host, port=port, threaded=True, use_reloader=False)
+        app.run(host=host, port=port, threaded=True, use_reloader=False, ssl_context=tls)
     except KeyboardInterrupt:
         pass
     finally:

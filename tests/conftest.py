@@ -42,7 +42,8 @@ def app_factory(tmp_path):
     made = []
 
     def make(**settings):
-        config = {"TESTING": True, "ROVER_WEB_DB_PATH": str(tmp_path / f"rover_web{len(made)}.sqlite3")}
+        config = {"TESTING": True, "ROVER_WEB_DB_PATH": str(tmp_path / f"rover_web{len(made)}.sqlite3"),
+                  "ROVER_WEB_SECRET_KEY": "tests"}  # not a key file in the checkout's instance folder
         config.update(settings)
         app = create_app(config)
         made.append(app)

@@ -48,6 +48,8 @@ def init_app(app: Flask, rover: Rover) -> None:
 
     @manager.user_loader
     def _load_user(name: str):
+        if "Authorization" in request.headers:
+            return None  # explicit credentials win over a cookie: the token alone decides (request_loader)
         user = service.accounts.get(name)  # each request: a removed user or a new role counts at once
         return SignedIn(user.name, user.role, "session") if user else None
 

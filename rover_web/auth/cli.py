@@ -118,9 +118,11 @@ def tokens_revoke(token_id: int) -> None:
 
 @tls.command("self-signed")
 @click.option("--host", "hosts", multiple=True, help="a name or address browsers will use (repeatable)")
-def tls_self_signed(hosts: tuple[str, ...]) -> None:
+@click.option("--dir", "directory", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="where to write cert.pem and key.pem (default: the instance folder's tls/)")
+def tls_self_signed(hosts: tuple[str, ...], directory: Path | None) -> None:
     """Write a self-signed certificate and key into the instance folder."""
-    directory = Path(current_app.instance_path) / "tls"
+    directory = directory or Path(current_app.instance_path) / "tls"
     cert, key = write_self_signed(directory, list(hosts) or default_hosts())
     click.echo(f"wrote {cert} and {key}")
     click.echo(f"use them with:\n  export ROVER_WEB_TLS_CERT={cert} ROVER_WEB_TLS_KEY={key}")

@@ -1,0 +1,20 @@
+"""`flask tls self-signed`'s certificate: loads into an SSL context, names the hosts, key kept private."""
+
+import ipaddress
+import ssl
+import stat
+
+from cryptography import x509
+
+from rover_web.auth.tls import write_self_signed
+
+
+def test_self_signed_certificate(tmp_path):
+    cert_path, key_path = write_self_signed(tmp_path / "tls", ["robot.local", "127.0.0.1"])
+    context = ssl.SSLContext(ssl.PROTOCOL_TLS_SERVER)
+    context.load_cert_chain(cert_path, key_path)
+    cert = x509.load_pem_x509_certificate(cert_path.read_bytes())
+    san = cert.extensions.get_extension_for_class(x509.SubjectAlternativeName).value
+    assert san.get_values_for_type(x509.DNSName) == ["robot.local"]
+    assert san.get_values_for_type(x509.IPAddress) == [ipaddress.ip_address("127.0.0.1")]
+    assert stat.S_IMODE(key_path.stat().st_mode) == 0o600
