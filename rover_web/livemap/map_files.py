@@ -25,16 +25,17 @@ import json
 import math
 import re
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import yaml
 from PIL import Image, ImageOps
 
-from rover_web.config import ConfigError
+from rover_web.config import ROOT, ConfigError
+
 from .geometry import MapGeometry, wrap_angle
-from rover_web.config import ROOT
 
 IMAGE_SUFFIXES = (".png", ".pgm")
 MAX_IMAGE_SIDE_PX = 8192
@@ -329,7 +330,8 @@ def _catalog_entry(name: str, entry: Any, root: Path, src: _Source) -> MapDefini
         raise src.error(f"{key}.{unknown[0]}", "unknown key; an entry has files and yaml_parameters")
     unknown = sorted(set(files) - {"path", "png_file", "yaml_file", "waypoint_file"})
     if unknown:
-        raise src.error(f"{key}.files.{unknown[0]}", "unknown key; files has path, png_file or yaml_file, waypoint_file")
+        raise src.error(f"{key}.files.{unknown[0]}",
+                        "unknown key; files has path, png_file or yaml_file, waypoint_file")
     rel_dir = files.get("path", "")
     if rel_dir in ("", "./", "."):
         directory = root.resolve()

@@ -27,6 +27,11 @@ def pose_from_stamped(msg) -> tuple[float, float, float, str, float]:
     return (*_pose_values(msg.pose), msg.header.frame_id, stamp_to_float(msg.header.stamp))
 
 
+def stamp_seconds(stamp) -> float:
+    """A builtin_interfaces/Time (e.g. from RosRuntime.now_msg) in seconds."""
+    return stamp_to_float(stamp)
+
+
 def goal_message(x: float, y: float, yaw: float, frame_id: str, stamp):
     """A fresh PoseStamped for /goal_pose."""
     msg = message_class(POSE_STAMPED)()

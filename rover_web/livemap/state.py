@@ -19,11 +19,13 @@ from __future__ import annotations
 import math
 import threading
 import time
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Callable, Iterable, Mapping, Sequence
 
-from .map_files import MapDefinition
+from rover_web.config import ROOT
+
 from .geometry import wrap_angle
+from .map_files import MapDefinition, load_catalog
 
 BOT_CM_DIAMETER = 35.4  # the Turtlebot 2 the campus rover was built on
 MIN_CM_PER_PIXEL = 0.01
@@ -48,8 +50,7 @@ class Pose2D:
 
 
 def _catalog_default() -> Mapping[str, MapDefinition]:
-    from rover_web.config import ROOT
-    from .map_files import load_catalog
+    """The floorplans bundled with rover_web (ROVER_WEB_MAPS_FILE's default), read only when asked for."""
     return load_catalog(ROOT / "map_files" / "all_maps.json")
 
 
@@ -98,7 +99,7 @@ class LiveMap:
                 "png_pixel_height": geometry.height_px * self.scale,
                 "current_pose": {},
                 "goal_pose": {},
-                "waypoints": [dict(zip(("x", "y"), self.to_pixels(w.x, w.y)), name=w.name)
+                "waypoints": [dict(zip(("x", "y"), self.to_pixels(w.x, w.y), strict=True), name=w.name)
                               for w in definition.waypoints],
             },
         }

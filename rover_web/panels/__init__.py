@@ -1,29 +1,30 @@
 """Mission control panels: operator buttons and status displays for any robot, defined in TOML.
 
 The default file (drone.toml beside this module) is the drone's take-off / return / stop panel;
-ROVER_WEB_PANELS_FILE names another. Modules: spec (the file and its validation), state (what a
-panel shows and allows), service (ROS side and the command path), oplog (SQLite operator log),
-routes (pages and API).
+ROVER_WEB_PANELS_FILE names another. Pages /panels, /panels/<panel>; API /api/panels/...;
+SSE channels `panel` (what the panels show) and `panel_log` (the operator log).
+Modules: spec (the file and its validation), state (what a panel shows and allows), service (ROS
+side and the command path), oplog (SQLite operator log), msgs (message fields), routes (pages and API).
 """
 
 from __future__ import annotations
 
 from rover_web.core.state import Rover
+
 from . import routes, spec
+from .msgs import field_kind
 from .oplog import OperatorLog
-from .service import PanelService
+from .service import TICK_S, PanelService
 
 
 def init_app(app, rover: Rover) -> None:
-    from .msgs import field_kind
-
     config = rover.config
     specs = spec.load(config["ROVER_WEB_PANELS_FILE"], config["ROVER_WEB_STALE_AFTER_S"], field_kind)
     rover.hub.register("panel", "panel_log")
     service = PanelService(specs, rover, OperatorLog(rover.db, config["ROVER_WEB_PANELS_LOG_KEEP"]))
-    app.extensions["rover_web_panels"] = service
+    rover.add_feature(service)
     app.register_blueprint(routes.bp)
     rover.add_panel(20, "panels/panels.html", "Control panels", channels=("panel",))
     rover.add_nav("Panels", "/panels")
-    service.start()
-    rover.on_shutdown(service.stop)
+    service.publish_view()
+    rover.every(TICK_S, service.tick, name="panels-ticker")

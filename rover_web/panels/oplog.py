@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 import time
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from typing import Any
 
 RESULTS = ("sent", "refused", "invalid", "unlocked", "locked")
@@ -52,7 +52,7 @@ def entry_dict(row) -> dict:
     return {
         "id": row["id"],
         "t": t,
-        "time": datetime.fromtimestamp(t, timezone.utc).isoformat(timespec="milliseconds"),
+        "time": datetime.fromtimestamp(t, UTC).isoformat(timespec="milliseconds"),
         "clock": datetime.fromtimestamp(t).strftime("%H:%M:%S"),  # the server's local time, as operators read it
         "panel": row["panel"],
         "control": row["control"],

@@ -4,16 +4,25 @@ from __future__ import annotations
 
 from flask import Blueprint, abort, current_app, jsonify, render_template, request
 
-from rover_web.web.http import ApiError, json_body
-from .service import PanelService
+from rover_web.core.state import current_feature
+from rover_web.web.http import ApiError, error_response, json_body
+
+from .service import CommandRefused, InvalidCommand, PanelError, PanelService, UnknownControl, UnknownPanel
 
 bp = Blueprint("panels", __name__)
 
 MAX_LOG_LIMIT = 500
 
+STATUS = {UnknownPanel: 404, UnknownControl: 404, InvalidCommand: 400, CommandRefused: 409}
+
+
+@bp.errorhandler(PanelError)
+def panel_error(exc: PanelError):
+    return error_response(STATUS[type(exc)], exc.code, str(exc))
+
 
 def service() -> PanelService:
-    return current_app.extensions["rover_web_panels"]
+    return current_feature(PanelService)
 
 
 def _client() -> str:
@@ -47,9 +56,7 @@ def panel_page(panel_id: str):
 def panel_summaries():
     """`panel_summaries()` for the dashboard card, evaluated only where a template calls it."""
     def summaries() -> list[dict]:
-        svc = current_app.extensions.get("rover_web_panels")
-        if svc is None:
-            return []
+        svc = service()
         views = svc.views()
         return [{"spec": spec, "view": views[pid]} for pid, spec in svc.specs.items()]
     return {"panel_summaries": summaries}
@@ -99,7 +106,9 @@ def lock(panel_id: str):
 @bp.post("/api/panels/<panel_id>/<control_id>")
 def command(panel_id: str, control_id: str):
     try:
-        body: dict | ApiError = json_body(required=False)
+        body: dict | InvalidCommand = json_body(required=False)
     except ApiError as exc:
-        body = exc  # still 404 first for an unknown control, then logged as an invalid command
+        if exc.status != 400:
+            raise
+        body = InvalidCommand(exc.message, exc.code)  # still 404 first for an unknown control, then logged
     return jsonify(service().command(panel_id, control_id, body, _client()))

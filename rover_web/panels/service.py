@@ -3,6 +3,7 @@
 Every command is decided here, whatever sent it (the page, curl, a script): unknown panel or
 control 404, malformed value 400, locked or not allowed in the current state 409, and in every
 refusal nothing is published. Accepted and refused commands alike land in the operator log.
+Refusals are PanelError subclasses; routes.py turns them into HTTP answers.
 """
 
 from __future__ import annotations
@@ -13,9 +14,10 @@ import threading
 import time
 from typing import Any
 
-from rover_web.web.http import ApiError
-from . import msgs as panel_msgs
+from rover_web.core.state import Rover
 from rover_web.web.validate import InvalidInput, only_keys
+
+from . import msgs
 from .oplog import OperatorLog
 from .spec import ControlSpec, InvalidValue, PanelSpec
 from .state import PanelState
@@ -28,15 +30,38 @@ VIEW_MAX_HZ = 10.0
 TICK_S = 0.25
 
 
+class PanelError(Exception):
+    """A panel action that was not carried out; `code` is the short machine-readable reason."""
+
+    def __init__(self, message: str, code: str):
+        super().__init__(message)
+        self.code = code
+
+
+class UnknownPanel(PanelError):
+    pass
+
+
+class UnknownControl(PanelError):
+    pass
+
+
+class InvalidCommand(PanelError):
+    """A command the client must fix: unreadable body, bad value, missing confirmation."""
+
+
+class CommandRefused(PanelError):
+    """A well-formed command the panel's state does not allow now (`locked`, `not_allowed`)."""
+
+
 class PanelService:
-    def __init__(self, specs: tuple[PanelSpec, ...], rover, oplog: OperatorLog):
+    def __init__(self, specs: tuple[PanelSpec, ...], rover: Rover, oplog: OperatorLog):
         self.rover = rover
         self.oplog = oplog
         self.specs = {s.id: s for s in specs}
         self.states = {s.id: PanelState(s) for s in specs}
         self._view_lock = threading.Lock()
         self._last_view: dict | None = None
-        self._thread: threading.Thread | None = None
         runtime = rover.runtime
         self._publishers: dict[str, Any] = {}
         for spec in specs:
@@ -58,7 +83,7 @@ class PanelService:
         def on_message(msg) -> None:
             now = time.monotonic()
             for state, display in readers:
-                state.update(display.id, panel_msgs.read_field(msg, display.field), now)
+                state.update(display.id, msgs.read_field(msg, display.field), now)
             self.publish_view()
         return on_message
 
@@ -84,24 +109,12 @@ class PanelService:
 
     # --- ticker: lock timeouts and staleness, which no message announces ---
 
-    def start(self) -> None:
+    def tick(self) -> None:
+        """Run every TICK_S: re-lock timed-out panels and send the view if staleness changed it."""
+        for state in self.states.values():
+            with state.lock:
+                self._expire(state)
         self.publish_view()
-        self._thread = threading.Thread(target=self._tick_loop, name="panels-ticker", daemon=True)
-        self._thread.start()
-
-    def stop(self) -> None:
-        if self._thread is not None:
-            self._thread.join(2 * TICK_S + 1.0)
-
-    def _tick_loop(self) -> None:
-        while not self.rover.stopping.wait(TICK_S):
-            try:
-                for state in self.states.values():
-                    with state.lock:
-                        self._expire(state)
-                self.publish_view()
-            except Exception:  # pragma: no cover - the ticker must not die silently
-                log.exception("panels ticker failed")
 
     def _expire(self, state: PanelState) -> None:
         """Lock a panel whose unlock timed out, and say so in its log (call with state.lock held)."""
@@ -114,8 +127,7 @@ class PanelService:
     def panel(self, panel_id: str) -> PanelState:
         state = self.states.get(panel_id)
         if state is None:
-            raise ApiError(404, "unknown_panel",
-                           f"no panel {panel_id[:40]!r}; panels: {', '.join(self.specs)}")
+            raise UnknownPanel(f"no panel {panel_id[:40]!r}; panels: {', '.join(self.specs)}", "unknown_panel")
         return state
 
     def unlock(self, panel_id: str, client: str) -> dict:
@@ -139,15 +151,18 @@ class PanelService:
         self.publish_view()
         return {"panel": panel_id, "locked": True, "log": entry, "state": state.view()}
 
-    def command(self, panel_id: str, control_id: str, body_or_error: dict | ApiError, client: str) -> dict:
-        """Check and publish one command; ApiError (logged) for anything that is not sent."""
+    def command(self, panel_id: str, control_id: str, body_or_error: dict | InvalidCommand, client: str) -> dict:
+        """Check and publish one command; a PanelError (logged) for anything that is not sent.
+
+        `body_or_error` is the request body, or why it could not be read: that is still logged as
+        an invalid command, but only once the panel and control are known to exist.
+        """
         state = self.panel(panel_id)
         control = state.spec.control(control_id)
         if control is None:
-            raise ApiError(404, "unknown_control",
-                           f"panel {panel_id!r} has no control {control_id[:40]!r}; controls: "
-                           f"{', '.join(c.id for c in state.spec.controls)}")
-        if isinstance(body_or_error, ApiError):
+            raise UnknownControl(f"panel {panel_id!r} has no control {control_id[:40]!r}; controls: "
+                                 f"{', '.join(c.id for c in state.spec.controls)}", "unknown_control")
+        if isinstance(body_or_error, InvalidCommand):
             self._refuse(state, control, None, "invalid", body_or_error, client)
         body = body_or_error
         try:
@@ -157,26 +172,26 @@ class PanelService:
             if not isinstance(confirmed, bool):
                 raise InvalidInput(f"'confirmed' must be true or false, got {type(confirmed).__name__}", "bad_type")
         except (InvalidInput, InvalidValue) as exc:
-            self._refuse(state, control, body.get("value"), "invalid", ApiError(400, exc.code, str(exc)), client)
+            self._refuse(state, control, body.get("value"), "invalid", InvalidCommand(str(exc), exc.code), client)
         if control.confirm and not confirmed:
-            self._refuse(state, control, value, "invalid", ApiError(
-                400, "confirmation_required",
-                f"{control.label} needs a confirmation: send {{\"confirmed\": true}} with the request"), client)
+            self._refuse(state, control, value, "invalid", InvalidCommand(
+                f"{control.label} needs a confirmation: send {{\"confirmed\": true}} with the request",
+                "confirmation_required"), client)
         with state.lock:
             self._expire(state)
             refusal = state.refusal(control)
             if refusal is not None:
-                self._refuse(state, control, value, "refused", ApiError(409, refusal.code, refusal.reason), client)
-            self._publishers[control.topic].publish(panel_msgs.scalar_message(control.type.name, value))
+                self._refuse(state, control, value, "refused", CommandRefused(refusal.reason, refusal.code), client)
+            self._publishers[control.topic].publish(msgs.scalar_message(control.type.name, value))
             state.renew()
             entry = self._record(panel_id, control.id, control.label, value, "sent", "", client)
         self.publish_view()
         return {"result": "sent", "panel": panel_id, "control": control.id, "topic": control.topic,
                 "type": control.type.name, "value": value, "log": entry}
 
-    def _refuse(self, state: PanelState, control: ControlSpec, value: Any, result: str, error: ApiError,
+    def _refuse(self, state: PanelState, control: ControlSpec, value: Any, result: str, error: PanelError,
                 client: str) -> None:
-        self._record(state.spec.id, control.id, control.label, value, result, error.message, client)
+        self._record(state.spec.id, control.id, control.label, value, result, str(error), client)
         raise error
 
     def _record(self, panel_id: str, control: str, label: str, value: Any, result: str, reason: str,

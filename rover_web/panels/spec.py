@@ -4,7 +4,7 @@ A panel is a set of status displays (a field of a subscribed topic), buttons (a 
 published on a topic) and inputs (an operator-chosen value published on a topic), plus the rules
 saying in which displayed states each control may be used. Commands are std_msgs scalars or
 std_msgs/String; displays may read a field of any message type. Pure Python: message fields are
-checked through the `field_kind` callable the caller passes (rover_web.ros.panel_msgs.field_kind).
+checked through the `field_kind` callable the caller passes (rover_web.panels.msgs.field_kind).
 
 Every error is a ConfigError reading "<file>: panel 'p', control 'c', field 'f': <what is wrong>",
 so the operator can fix the file without reading code.
@@ -15,9 +15,10 @@ from __future__ import annotations
 import math
 import re
 import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 from rover_web.config import TOPIC_PATTERN, ConfigError
 
@@ -198,7 +199,7 @@ class _Where:
     def __init__(self, path: str, panel: str | None = None, item: str | None = None):
         self.path, self.panel, self.item = path, panel, item
 
-    def at(self, item: str) -> "_Where":
+    def at(self, item: str) -> _Where:
         return _Where(self.path, self.panel, item)
 
     def error(self, problem: str, field: str | None = None) -> ConfigError:
@@ -310,8 +311,8 @@ def _control(cid: str, c: Any, where: _Where, displays: dict[str, DisplaySpec]) 
     type_name = _message_type(c, where)
     stype = SCALAR_TYPES.get(type_name)
     if stype is None:
-        raise where.error(f"controls publish a std_msgs scalar ({', '.join(sorted(t.split('/')[-1] for t in SCALAR_TYPES))}); "
-                          f"{type_name} is not one", "type")
+        names = ", ".join(sorted(t.split("/")[-1] for t in SCALAR_TYPES))
+        raise where.error(f"controls publish a std_msgs scalar ({names}); {type_name} is not one", "type")
     fields: dict[str, Any] = {}
     if kind == "button":
         if "value" not in c:
@@ -334,7 +335,8 @@ def _control(cid: str, c: Any, where: _Where, displays: dict[str, DisplaySpec]) 
                     raise where.error(f"{stype.short} has no numeric range; remove '{key}'", key)
         if stype.kind == "string":
             max_length = c.get("max_length", 256)
-            if isinstance(max_length, bool) or not isinstance(max_length, int) or not 1 <= max_length <= MAX_STRING_LENGTH:
+            if isinstance(max_length, bool) or not isinstance(max_length, int) \
+                    or not 1 <= max_length <= MAX_STRING_LENGTH:
                 raise where.error(f"must be an integer from 1 to {MAX_STRING_LENGTH}, got {_describe(max_length)}",
                                   "max_length")
             fields["max_length"] = max_length

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 from .spec import ControlSpec, DisplaySpec, InvalidValue, PanelSpec, coerce
 
@@ -184,8 +185,9 @@ class PanelState:
             controls = [{**control_description(c), **view["controls"][c.id]} for c in spec.controls]
             return {"id": spec.id, "title": spec.title, "locked": view["locked"],
                     "unlock_timeout_s": spec.unlock_timeout_s, "stale_after_s": spec.stale_after_s,
-                    "light": None if spec.light is None else {"display": spec.light.display, "idle": list(spec.light.idle),
-                                                              "label": spec.light.label, "state": view["light"]},
+                    "light": None if spec.light is None else {
+                        "display": spec.light.display, "idle": list(spec.light.idle),
+                        "label": spec.light.label, "state": view["light"]},
                     "displays": displays, "controls": controls}
 
 

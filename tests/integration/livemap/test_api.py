@@ -8,6 +8,9 @@ from urllib.parse import quote
 import pytest
 from PIL import Image
 
+from rover_web.core.state import EXTENSION
+from rover_web.livemap.service import LiveMapService
+
 BASEMENT = "Science Hall Basement"
 LAB = "Robotics Lab"
 B = quote(BASEMENT)
@@ -169,8 +172,7 @@ def test_bad_goals_are_400_and_publish_nothing(client, ros_peer):
 
 
 def test_maps_settings_default_map_single_yaml_and_none(app_factory):
-    from rover_web.config import ROOT
-    from rover_web.config import ConfigError
+    from rover_web.config import ROOT, ConfigError
 
     with pytest.raises(ConfigError, match="ROVER_WEB_LIVEMAP_DEFAULT_MAP: no map named 'Attic'"):
         app_factory(ROVER_WEB_LIVEMAP_DEFAULT_MAP="Attic")
@@ -188,6 +190,7 @@ def test_maps_settings_default_map_single_yaml_and_none(app_factory):
 
 
 def test_the_dashboard_renders_the_robot_dot_with_the_page(app):
-    app.extensions["livemap"].on_pose((18.0, 10.5, 0.0, "map", 1.0))   # as the /amcl_pose callback would
+    service = app.extensions[EXTENSION].feature(LiveMapService)
+    service.on_pose((18.0, 10.5, 0.0, "map", 1.0))   # as the /amcl_pose callback would
     html = app.test_client().get("/").data.decode()
     assert 'style="left: 50.0%; top: 50.0%"' in html and "18.0, 10.5 m" in html

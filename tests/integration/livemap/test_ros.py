@@ -138,7 +138,8 @@ def test_a_live_occupancy_grid_becomes_a_map_image(live_server_factory, ros_peer
     peer.publish("/map", grid(80, 50, origin=(-4.0, -2.0)))
     event = stream.wait_for("live_map", lambda d: d["width_px"] == 80)["json"]
     assert event["version"] == live["version"] + 1
-    with Image.open(io.BytesIO(requests.get(f"{server.url}/api/maps/{quote('live map')}/image", timeout=5).content)) as image:
+    png = requests.get(f"{server.url}/api/maps/{quote('live map')}/image", timeout=5).content
+    with Image.open(io.BytesIO(png)) as image:
         assert image.size == (80, 50)
     ok = requests.post(f"{server.url}/api/maps/{quote('live map')}/goal", json={"x": 3.9, "y": 2.9}, timeout=5)
     assert ok.status_code == 200

@@ -7,13 +7,13 @@ import requests
 
 from tests.support.panels_support import (
     STRING,
-    drone_sim,
+    drone_sim,  # noqa: F401 (fixture)
     feed_status,
     log_entries,
     post,
     wait_display,
     wait_subscribers,
-)  # noqa: F401
+)
 
 INT8 = "std_msgs/msg/Int8"
 

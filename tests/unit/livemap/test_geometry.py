@@ -13,7 +13,7 @@ BASEMENT = MapGeometry(800, 480, 0.05, -2.0, -1.5, 0.0)
 
 
 def close(a, b, tol=1e-9):
-    return all(math.isclose(x, y, abs_tol=tol) for x, y in zip(a, b))
+    return all(math.isclose(x, y, abs_tol=tol) for x, y in zip(a, b, strict=True))
 
 
 @pytest.mark.parametrize("world, pixel", [

@@ -9,9 +9,8 @@ from pathlib import Path
 import pytest
 from PIL import Image
 
-from rover_web.config import ConfigError
+from rover_web.config import ROOT, ConfigError
 from rover_web.livemap.map_files import first_waypoint_or_centre, load_catalog, maps_file_path
-from rover_web.config import ROOT
 
 SHIPPED = ROOT / "map_files" / "all_maps.json"
 
@@ -194,7 +193,8 @@ def test_a_map_server_yaml_may_not_reach_outside_either(tmp_path):
     (tmp_path / "maps").mkdir()
     (tmp_path / "maps" / "x.yaml").write_text("image: ../outside.png\nresolution: 0.1\norigin: [0, 0, 0]\n")
     expect_error(tmp_path / "maps" / "x.yaml", "x.yaml", "image", "'..'")
-    (tmp_path / "maps" / "x.yaml").write_text(f"image: {tmp_path / 'outside.png'}\nresolution: 0.1\norigin: [0, 0, 0]\n")
+    outside = tmp_path / "outside.png"
+    (tmp_path / "maps" / "x.yaml").write_text(f"image: {outside}\nresolution: 0.1\norigin: [0, 0, 0]\n")
     expect_error(tmp_path / "maps" / "x.yaml", "image", "leads outside")
     (tmp_path / "maps" / "x.yaml").write_text("image: [1\n")
     expect_error(tmp_path / "maps" / "x.yaml", "not valid YAML")

@@ -5,6 +5,9 @@ import math
 import numpy as np
 import pytest
 
+from rover_web.livemap.geometry import MapGeometry
+from rover_web.livemap.map_files import MapDefinition, Waypoint
+from rover_web.livemap.occupancy import FREE_GREY, OCCUPIED_GREY, UNKNOWN_GREY, grid_to_image, image_to_png
 from rover_web.livemap.state import (
     LiveMap,
     Pose2D,
@@ -15,12 +18,11 @@ from rover_web.livemap.state import (
     plan_payload,
     pose_payload,
 )
-from rover_web.livemap.map_files import MapDefinition, Waypoint
-from rover_web.livemap.geometry import MapGeometry
-from rover_web.livemap.occupancy import FREE_GREY, OCCUPIED_GREY, UNKNOWN_GREY, grid_to_image, image_to_png
+
+HALL_GEOMETRY = MapGeometry(800, 480, 0.05, -2.0, -1.5, 0.0)
 
 
-def definition(name="Hall", geometry=MapGeometry(800, 480, 0.05, -2.0, -1.5, 0.0), waypoints=()):
+def definition(name="Hall", geometry=HALL_GEOMETRY, waypoints=()):
     files = {"path": "hall/", "png": {"file_name": "hall.png", "cm_per_pixel": geometry.cm_per_pixel,
                                       "pixel_width": geometry.width_px, "pixel_height": geometry.height_px}}
     yaml = {"resolution": geometry.resolution_m, "origin": [geometry.origin_x, geometry.origin_y, geometry.origin_yaw]}

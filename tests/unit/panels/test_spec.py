@@ -185,7 +185,8 @@ MISTAKES = [
      ["control 'target'", "field 'type'", "/phase", "one topic carries one type"]),
     ("display and control disagree on a topic's type", _set(["controls", "target", "topic"], "/status"),
      ["field 'type'", "/status"]),
-    ("empty panel", lambda p, d: (p.pop("controls"), p.pop("displays"), p.pop("light")), ["no displays and no controls"]),
+    ("empty panel", lambda p, d: (p.pop("controls"), p.pop("displays"), p.pop("light")),
+     ["no displays and no controls"]),
     ("no panels", lambda p, d: d.update(panels={}), ["defines no panels"]),
     ("unknown top-level key", lambda p, d: d.update(panel={}), ["unknown field 'panel'"]),
 ]

@@ -3,8 +3,8 @@
 import pytest
 
 from rover_web.panels import spec
-from rover_web.panels.state import PanelState, format_value
 from rover_web.panels.msgs import field_kind
+from rover_web.panels.state import PanelState, format_value
 
 
 class Clock:
