@@ -1,6 +1,6 @@
 """Camera frames to JPEG: pixel layouts of sensor_msgs/Image, resizing, error frames. Pure Python.
 
-Nothing here knows about ROS: rover_web/ros/camera_msgs.py turns a message into a RawImage or a
+Nothing here knows about ROS: rover_web/camera/msgs.py turns a message into a RawImage or a
 CompressedFrame, and these functions turn that into JPEG bytes (numpy for the pixel layout,
 Pillow, i.e. libjpeg-turbo, for scaling and encoding).
 
@@ -11,7 +11,8 @@ Choices an operator may want to know:
   reading" on depth cameras, so it stays black and does not count towards the range.
 - A JPEG CompressedImage is passed through byte for byte (the asked quality does not apply)
   unless a different size is asked for; then, and for PNG (or any other format Pillow reads),
-  it is decoded, scaled and encoded at the asked quality. `compressedDepth` images are refused (they are not an image file).
+  it is decoded, scaled and encoded at the asked quality. `compressedDepth` images are refused
+  (they are not an image file).
 - Width and height both given: exactly that size (web_video_server does the same); one given:
   the other follows the aspect ratio.
 """

@@ -1,9 +1,10 @@
-"""sensor_msgs/Image and CompressedImage to the plain frames rover_web.imaging encodes."""
+"""sensor_msgs/Image and CompressedImage to the plain frames imaging.py encodes."""
 
 from __future__ import annotations
 
-from .imaging import CompressedFrame, RawImage
 from rover_web.ros.convert import stamp_to_float
+
+from .imaging import CompressedFrame, RawImage
 
 IMAGE = "sensor_msgs/msg/Image"
 COMPRESSED = "sensor_msgs/msg/CompressedImage"

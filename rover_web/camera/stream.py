@@ -14,10 +14,12 @@ from __future__ import annotations
 import threading
 import time
 from collections import deque
-from typing import Any, Callable, NamedTuple
+from collections.abc import Callable
+from typing import Any, NamedTuple
+
+from rover_web.ros.topic_stats import TopicStats
 
 from .imaging import Jpeg
-from rover_web.ros.topic_stats import TopicStats
 
 
 class StreamKey(NamedTuple):

@@ -1,4 +1,4 @@
-"""Echoing any topic to browsers: measured rate and bandwidth, throttled decoding. Pure Python.
+"""Echoing any topic to browsers: measured rate and bandwidth, throttled decoding, the SSE frames. Pure Python.
 
 One TopicEcho per viewed topic is fed the serialized messages by a raw ROS subscription: every
 message is counted (rate, bandwidth) but only a few a second are deserialized and converted to
@@ -11,7 +11,10 @@ from __future__ import annotations
 import threading
 import time
 from collections import deque
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
+
+from rover_web.events.hub import encode
 
 
 class TrafficMeter:
@@ -151,3 +154,12 @@ class TopicEcho:
             self._closed = True
             self._raw = None
             self._cond.notify_all()
+
+
+def echo_event(echo: TopicEcho, kind: str, sample=None) -> bytes:
+    """An SSE frame without an id: a reconnecting browser wants the newest message, not a replay."""
+    data = {"topic": echo.topic, "type": echo.type_name, "qos": echo.qos, "max_hz": round(1 / echo.min_interval_s, 3),
+            "stats": echo.meter.snapshot()}
+    if sample is not None:
+        data["seq"], data["msg"], data["error"] = sample
+    return f"event: {kind}\ndata: {encode(data)}\n\n".encode()

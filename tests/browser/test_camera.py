@@ -4,6 +4,8 @@ import time
 
 import pytest
 
+from rover_web.camera.service import CameraStreams
+
 pytestmark = pytest.mark.browser
 
 
@@ -38,13 +40,13 @@ def test_camera_panel_without_a_camera_says_so_without_failed_requests(live_serv
     assert "no image topic /camera/image_raw" in page.locator("#camera-message").inner_text()
     page.wait_for_load_state("networkidle")
     assert page.watch.console_errors == [] and page.watch.offhost == []
-    assert live_server.app.extensions["rover_web_camera"].viewers == 0
+    assert live_server.rover.feature(CameraStreams).viewers == 0
 
 
 def test_hidden_tab_drops_the_stream(live_server, sim_process, page):
     sim_process()
     page.goto(live_server.url + "/")
-    camera = live_server.app.extensions["rover_web_camera"]
+    camera = live_server.rover.feature(CameraStreams)
     deadline = time.monotonic() + 20
     while camera.viewers != 1:
         assert time.monotonic() < deadline, page.locator("#camera-message").inner_text()

@@ -9,6 +9,7 @@ import pytest
 import requests
 from PIL import Image
 
+from rover_web.camera.service import CameraStreams
 from tests.support.camera_peer import ImagePublisher
 from tests.support.mjpeg import MjpegClient
 from tests.support.waiting import wait_until
@@ -54,7 +55,7 @@ def wait_listed(server, topic, timeout=15.0):
 
 
 def streams(server):
-    return server.app.extensions["rover_web_camera"]
+    return server.rover.feature(CameraStreams)
 
 
 def subscriber_count(peer, topic):

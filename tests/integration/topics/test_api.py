@@ -6,8 +6,8 @@ import time
 import pytest
 import requests
 
+from rover_web.topics.service import TopicBrowser
 from tests.support.camera_peer import ImagePublisher
-
 from tests.support.waiting import wait_until
 
 TWIST = "geometry_msgs/msg/Twist"
@@ -19,7 +19,7 @@ def topic_entry(server, name):
 
 
 def echoes(server):
-    return server.app.extensions["rover_web_topics"].echoes
+    return server.rover.feature(TopicBrowser).echoes
 
 
 def test_a_topic_of_another_process_is_listed_with_its_type_live(live_server, ros_peer, sse_client):

@@ -6,9 +6,10 @@ import time
 
 import pytest
 
-from rover_web.camera import multipart_part, parse_stream_args
-from rover_web.camera.stream import FrameProducer, StreamClosed, StreamKey
 from rover_web.camera.imaging import Jpeg
+from rover_web.camera.mjpeg import multipart_part
+from rover_web.camera.params import parse_stream_args
+from rover_web.camera.stream import FrameProducer, StreamClosed, StreamKey
 from rover_web.core.leases import Closed, Leases
 from rover_web.web.validate import InvalidInput
 

@@ -1,0 +1,17 @@
+"""The multipart/x-mixed-replace framing of an MJPEG stream. Pure Python."""
+
+from __future__ import annotations
+
+from .imaging import Jpeg
+
+BOUNDARY = "frame"
+MIMETYPE = f"multipart/x-mixed-replace; boundary={BOUNDARY}"
+OPENING = f"--{BOUNDARY}\r\n".encode()  # sent first, so the headers go out before the first frame
+PART_END = b"\r\n" + OPENING
+
+
+def multipart_part(jpeg: Jpeg) -> bytes:
+    """One JPEG and the boundary after it, so a browser shows the frame as soon as it arrives."""
+    head = (f"Content-Type: image/jpeg\r\nContent-Length: {len(jpeg.data)}\r\n"
+            f"X-Timestamp: {jpeg.stamp:.9f}\r\n\r\n").encode()
+    return head + jpeg.data + PART_END

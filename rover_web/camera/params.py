@@ -1,0 +1,47 @@
+"""The query of GET /stream and /snapshot, checked: web_video_server's arguments, plus msg_type. Pure Python."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from rover_web.web.validate import InvalidInput, topic_name
+
+QOS_PROFILES = ("default", "sensor_data")
+# web_video_server's `type` is the stream format; MJPEG is the one this server makes.
+STREAM_TYPES = ("mjpeg",)
+
+
+def _int_arg(args: Mapping[str, str], name: str, low: int, high: int, *, original_ok: bool = False) -> int | None:
+    text = args.get(name)
+    if text is None or text.strip() == "":
+        return None
+    text = text.strip()
+    try:
+        value = int(text, 10)
+    except ValueError:
+        raise InvalidInput(f"'{name}' must be a whole number, got {text[:20]!r}", "bad_type") from None
+    if original_ok and value in (0, -1):  # web_video_server's "keep the camera's size"
+        return None
+    if not low <= value <= high:
+        raise InvalidInput(f"'{name}' must be between {low} and {high}, got {value}", "out_of_range")
+    return value
+
+
+def parse_stream_args(args: Mapping[str, str], *, max_dimension: int, default_quality: int) -> dict:
+    """Check a /stream or /snapshot query; the message type and QoS may still be left to the graph."""
+    topic = topic_name(args.get("topic"))
+    width = _int_arg(args, "width", 1, max_dimension, original_ok=True)
+    height = _int_arg(args, "height", 1, max_dimension, original_ok=True)
+    quality = _int_arg(args, "quality", 1, 100)
+    qos = args.get("qos_profile") or None
+    if qos is not None and qos not in QOS_PROFILES:
+        raise InvalidInput(f"'qos_profile' must be one of {', '.join(QOS_PROFILES)}; got {qos[:40]!r}", "bad_value")
+    stream_type = args.get("type")
+    msg_type = args.get("msg_type") or None
+    if stream_type and stream_type not in STREAM_TYPES:
+        if "/" not in stream_type:
+            raise InvalidInput(f"stream type {stream_type[:40]!r} is not supported; this server streams mjpeg",
+                               "unsupported_stream_type")
+        msg_type = msg_type or stream_type  # type=sensor_msgs/msg/Image works too
+    return {"topic": topic, "width": width, "height": height,
+            "quality": default_quality if quality is None else quality, "qos": qos, "msg_type": msg_type}

@@ -1,0 +1,177 @@
+"""CameraStreams: the frame producers of one app, shared by viewers, with its viewer limit and encoding settings."""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections.abc import Mapping
+
+from rover_web.core.leases import Closed, Leases
+from rover_web.core.state import Rover
+from rover_web.ros.graph import publishers_best_effort, topic_types
+from rover_web.ros.typesupport import UnknownMessageType, message_class
+from rover_web.web.validate import InvalidInput
+
+from . import imaging
+from . import msgs as camera_msgs
+from .params import parse_stream_args
+from .stream import FrameProducer, StreamKey
+
+log = logging.getLogger(__name__)
+
+
+class StreamRefused(Exception):
+    """A stream this service will not open; `code` is the short machine-readable reason."""
+
+    def __init__(self, message: str, code: str):
+        super().__init__(message)
+        self.code = code
+
+
+class UnknownTopic(StreamRefused):
+    """Not in the ROS graph, and no message type was given to wait for it."""
+
+
+class Unavailable(StreamRefused):
+    """Not now: too many viewers, or the app is shutting down."""
+
+
+class CannotSubscribe(StreamRefused):
+    """The ROS subscription could not be made."""
+
+
+class CameraStreams:
+    """The producers of one app, its viewer limit and the encoding settings."""
+
+    def __init__(self, rover: Rover):
+        self.rover = rover
+        config = rover.config
+        self.max_dimension = config["ROVER_WEB_CAMERA_MAX_DIMENSION"]
+        self.default_quality = config["ROVER_WEB_CAMERA_QUALITY"]
+        self.max_viewers = config["ROVER_WEB_CAMERA_MAX_VIEWERS"]
+        self.snapshot_timeout_s = config["ROVER_WEB_CAMERA_SNAPSHOT_TIMEOUT_S"]
+        self.producers: Leases[FrameProducer] = Leases(self._open, self._close,
+                                                       config["ROVER_WEB_CAMERA_IDLE_TIMEOUT_S"])
+        self._viewers = 0
+        self._lock = threading.Lock()
+
+    # --- producers ---
+
+    def _open(self, key: StreamKey) -> FrameProducer:
+        producer = FrameProducer(key, lambda raw: self._encode(key, raw))
+        read = camera_msgs.frame_reader(key.msg_type)
+        producer.subscription = self.rover.runtime.subscribe(
+            key.msg_type, key.topic, lambda msg: producer.put(read(msg)), qos=key.qos, track=False)
+        return producer
+
+    def _close(self, producer: FrameProducer) -> None:
+        producer.close()
+        if self.rover.runtime.running:  # after runtime.stop the node and its subscriptions are gone
+            self.rover.runtime.destroy(producer.subscription)
+
+    @staticmethod
+    def _encode(key: StreamKey, raw) -> imaging.Jpeg:
+        try:
+            return imaging.encode_frame(raw, key.quality, key.width, key.height)
+        except Exception:  # a bug, not bad data: keep the stream alive and say where to look
+            log.exception("encoding a frame from %s failed", key.topic)
+            return imaging.error_frame("the server could not encode this frame; see its log", "internal_error",
+                                       key.width, key.height)
+
+    # --- requests ---
+
+    def key_for(self, args: Mapping[str, str]) -> StreamKey:
+        """The stream a request asks for, with type and QoS resolved from the ROS graph.
+
+        InvalidInput for a bad query, UnknownTopic for a topic the graph does not know (and no type given).
+        """
+        parsed = parse_stream_args(args, max_dimension=self.max_dimension, default_quality=self.default_quality)
+        topic = parsed["topic"]
+        runtime = self.rover.runtime
+        known = topic_types(runtime).get(topic)
+        if parsed["msg_type"]:
+            msg_type = _image_type(parsed["msg_type"])
+            if known and msg_type not in known:
+                raise InvalidInput(f"{topic} carries {', '.join(known)}, not {msg_type}", "type_mismatch")
+        else:
+            if not known:
+                raise UnknownTopic(f"no topic {topic} in the ROS graph (GET /api/topics lists them); to wait for a "
+                                   f"camera that is not up yet, add msg_type=sensor_msgs/msg/Image or CompressedImage",
+                                   "unknown_topic")
+            images = [t for t in known if t in camera_msgs.IMAGE_TYPES]
+            if not images:
+                raise InvalidInput(f"{topic} carries {', '.join(known)}; streams need sensor_msgs/msg/Image "
+                                   f"or sensor_msgs/msg/CompressedImage", "not_an_image_topic")
+            msg_type = images[0]
+        qos = parsed["qos"]
+        if qos is None:  # like `ros2 topic echo`: best effort if any publisher is, or nothing would arrive
+            qos = "sensor_data" if publishers_best_effort(runtime, topic) else "default"
+        return StreamKey(topic, msg_type, qos, parsed["width"], parsed["height"], parsed["quality"])
+
+    def acquire(self, key: StreamKey) -> FrameProducer:
+        with self._lock:
+            if self._viewers >= self.max_viewers:
+                raise Unavailable(f"{self._viewers} camera viewers are connected already "
+                                  f"(ROVER_WEB_CAMERA_MAX_VIEWERS)", "too_many_viewers")
+            self._viewers += 1
+        try:
+            return self.producers.acquire(key)
+        except Closed:
+            self._viewer_left()
+            raise Unavailable("the server is shutting down", "shutting_down") from None
+        except Exception as exc:
+            self._viewer_left()
+            log.exception("cannot subscribe to %s", key.topic)
+            raise CannotSubscribe(f"cannot subscribe to {key.topic}: {exc}", "cannot_subscribe") from None
+
+    def release(self, key: StreamKey) -> None:
+        self.producers.release(key)
+        self._viewer_left()
+
+    def _viewer_left(self) -> None:
+        with self._lock:
+            self._viewers -= 1
+
+    @property
+    def viewers(self) -> int:
+        with self._lock:
+            return self._viewers
+
+    def describe(self) -> list[dict]:
+        out = []
+        for key, producer, users in self.producers.items():
+            out.append({"topic": key.topic, "msg_type": key.msg_type, "qos_profile": key.qos,
+                        "width": key.width, "height": key.height, "quality": key.quality,
+                        "viewers": users, **producer.stats()})
+        return out
+
+    def image_topics(self) -> list[dict]:
+        try:
+            types = topic_types(self.rover.runtime)
+        except Exception:  # the node is gone (shutdown): an empty list, not a broken page
+            return []
+        return [{"name": name, "type": next(t for t in ts if t in camera_msgs.IMAGE_TYPES)}
+                for name, ts in sorted(types.items()) if any(t in camera_msgs.IMAGE_TYPES for t in ts)]
+
+    def panel(self) -> dict:
+        """What the dashboard's camera panel shows: the configured topic first, even before it exists."""
+        topic = self.rover.config["ROVER_WEB_CAMERA_TOPIC"]
+        topics = self.image_topics()
+        if topic not in [t["name"] for t in topics]:
+            topics.insert(0, {"name": topic, "type": None})
+        return {"topic": topic, "image_topics": topics}
+
+    def close(self) -> None:
+        self.producers.close_all()
+
+
+def _image_type(name: str) -> str:
+    canonical = camera_msgs.image_type(name)
+    if canonical:
+        return canonical
+    try:
+        message_class(name)
+    except UnknownMessageType as exc:
+        raise InvalidInput(str(exc), "unknown_type") from None
+    raise InvalidInput(f"{name[:80]} is not an image type; use sensor_msgs/msg/Image or "
+                       f"sensor_msgs/msg/CompressedImage", "not_an_image_type")
