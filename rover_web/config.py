@@ -14,9 +14,10 @@ import math
 import os
 import re
 import tomllib
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import Any
 
 # The checkout (or install) root: templates/, static/ and map_files/ are found from here.
 ROOT = Path(__file__).resolve().parent.parent
@@ -86,13 +87,15 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("MAX_LINEAR_MPS", 5.0, "float", "linear speed at full joystick deflection (m/s)", 0.0, 100),
     Setting("MAX_ANGULAR_RPS", 2.0, "float", "turn rate at full joystick deflection (rad/s)", 0.0, 100),
     Setting("TELEOP_RATE_HZ", 40.0, "float",
-            "rate at which the server republishes the held joystick/keyboard/REST command on the velocity topic", 1, 200),
+            "rate at which the server republishes the held joystick/keyboard/REST command on the velocity topic",
+            1, 200),
     Setting("TELEOP_DEADMAN_S", 0.3, "float",
             "a joystick/keyboard command with no fresh input for this long is stopped (zero published)", 0.05, 5),
     Setting("TELEOP_MAX_FRAME_BYTES", 4096, "int",
             "largest teleop WebSocket frame; a bigger one closes the socket with 1009", 256, 65536),
     Setting("TELEOP_WS_PING_S", 10.0, "float",
-            "teleop WebSocket ping interval; a client that misses a pong loses the socket and control (0: off)", 0, 300),
+            "teleop WebSocket ping interval; a client that misses a pong loses the socket and control (0: off)",
+            0, 300),
     Setting("TELEOP_REST_DEFAULT_SPEED", 0.2, "float",
             "speed of POST /api/teleop without `speed`, as a fraction of the maxima", 0, 1),
     Setting("TELEOP_REST_DEFAULT_DURATION_S", 0.5, "float",
@@ -105,7 +108,8 @@ SETTINGS: tuple[Setting, ...] = (
             "std_msgs/Float64MultiArray (n x 2, lng then lat) the whole ordered mission goes to on \"send mission\""),
     Setting("FIX_TOPIC", "/fix", "topic", "sensor_msgs/NavSatFix shown as the robot's marker and track on the map"),
     Setting("MAX_WAYPOINTS", 500, "int", "most waypoints a mission may hold (409 beyond)", 1, 100000),
-    Setting("FIX_TRACK_POINTS", 500, "int", "GPS track points kept and drawn behind the robot (oldest dropped)", 2, 20000),
+    Setting("FIX_TRACK_POINTS", 500, "int", "GPS track points kept and drawn behind the robot (oldest dropped)",
+            2, 20000),
     Setting("MAP_PLACE_NAME", "Nathan Benderson Park, FL", "str", "name of the place the map opens on"),
     Setting("MAP_CENTER_LNG", -82.4500873, "float", "longitude the map opens on (degrees east)", -180, 180),
     Setting("MAP_CENTER_LAT", 27.3742443, "float", "latitude the map opens on (degrees north)", -85, 85),
@@ -115,7 +119,8 @@ SETTINGS: tuple[Setting, ...] = (
             "unset or missing means no basemap"),
     # --- panels ---
     Setting("PANELS_FILE", None, "optional_str",
-            "TOML file defining the mission control panels; unset means the drone panel in rover_web/panels/drone.toml"),
+            "TOML file defining the mission control panels; unset means the drone panel in "
+            "rover_web/panels/drone.toml"),
     Setting("PANELS_LOG_SHOWN", 20, "int", "operator-log entries a panel page shows (newest first)", 1, 500),
     Setting("PANELS_LOG_KEEP", 10000, "int", "operator-log entries kept per panel in the database (oldest deleted)",
             100, 10_000_000),
@@ -123,7 +128,8 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("MAPS_FILE", "map_files/all_maps.json", "optional_str",
             "floorplans: an all_maps.json catalog or one map_server yaml (relative paths from the repository "
             "root); set it empty in the environment for none"),
-    Setting("LIVEMAP_DEFAULT_MAP", None, "optional_str", "map /livemap and the dashboard show first; unset: the first one"),
+    Setting("LIVEMAP_DEFAULT_MAP", None, "optional_str",
+            "map /livemap and the dashboard show first; unset: the first one"),
     Setting("LIVEMAP_BOT_DIAMETER_CM", 35.4, "float", "robot diameter drawn on the map (cm)", 1, 10000),
     Setting("AMCL_POSE_TOPIC", "/amcl_pose", "topic",
             "geometry_msgs/PoseWithCovarianceStamped robot pose in the map frame (transient local)"),
@@ -151,7 +157,8 @@ SETTINGS: tuple[Setting, ...] = (
             "most /stream and /snapshot requests served at once (503 beyond); each holds a server thread", 1, 1024),
     Setting("CAMERA_SNAPSHOT_TIMEOUT_S", 5.0, "float", "how long /snapshot waits for a frame", 0.1, 60),
     # --- topic browser ---
-    Setting("TOPICS_REFRESH_S", 1.0, "float", "how often the topic list (`topics` channel) is re-read from the ROS graph",
+    Setting("TOPICS_REFRESH_S", 1.0, "float",
+            "how often the topic list (`topics` channel) is re-read from the ROS graph",
             0.2, 60),
     Setting("TOPICS_ECHO_HZ", 5.0, "float", "most messages a second the topic browser shows of one topic", 0.1, 50),
     Setting("TOPICS_ECHO_MAX_ITEMS", 32, "int",

@@ -12,8 +12,8 @@ import time
 from pathlib import Path
 
 import pytest
-from rover_web.config import ROOT
 
+from rover_web.config import ROOT
 
 
 def pytest_configure(config):
@@ -121,9 +121,10 @@ class ServerProcess:
         self.proc = None
         self.log_path = None
 
-    def start(self, timeout: float = 30.0) -> "ServerProcess":
-        import requests
+    def start(self, timeout: float = 30.0) -> ServerProcess:
         import tempfile
+
+        import requests
 
         cmd = self.args or [sys.executable, "-m", "flask", "--app", "rover_web", "run", "--no-reload",
                             "--host", "127.0.0.1", "--port", str(self.port)]

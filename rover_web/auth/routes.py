@@ -43,7 +43,8 @@ def check_access():
 
 
 def _forbidden(needed: str):
-    return error_response(403, "forbidden", f"this needs the {needed} role; {current_user.name} is a {current_user.role}")
+    return error_response(403, "forbidden",
+                          f"this needs the {needed} role; {current_user.name} is a {current_user.role}")
 
 
 def require(role: str) -> None:

@@ -10,7 +10,7 @@ from __future__ import annotations
 import threading
 import time
 from collections import deque
-from typing import Callable
+from collections.abc import Callable
 
 MAX_TRACKED_NAMES = 10_000  # names are attacker-chosen: the table must not grow without bound
 

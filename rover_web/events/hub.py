@@ -15,7 +15,8 @@ import re
 import threading
 import time
 from collections import deque
-from typing import Any, Iterable
+from collections.abc import Iterable
+from typing import Any
 
 CHANNEL_RE = re.compile(r"^[a-z][a-z0-9_]{0,31}$")
 
@@ -179,7 +180,7 @@ class EventHub:
     def closed(self) -> bool:
         return self._closed
 
-    def subscribe(self, channels: Iterable[str], last_event_id: int | None = None) -> "Subscription":
+    def subscribe(self, channels: Iterable[str], last_event_id: int | None = None) -> Subscription:
         with self._cond:
             if self._clients >= self._max_clients:
                 raise TooManyClients(f"{self._clients} event streams are open already")
@@ -253,7 +254,7 @@ class Subscription:
             self._open = False
             self._hub._release()
 
-    def __enter__(self) -> "Subscription":
+    def __enter__(self) -> Subscription:
         return self
 
     def __exit__(self, *exc: object) -> None:

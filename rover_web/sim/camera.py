@@ -8,8 +8,8 @@ uses little CPU however long it runs.
 from __future__ import annotations
 
 import argparse
-import sys
 import array
+import sys
 import time
 
 import numpy as np
@@ -99,7 +99,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--camera-qos", choices=("default", "sensor_data"), default="default",
                        help="publisher QoS: default (reliable) or sensor_data (best effort, as some drivers do)")
     group.add_argument("--camera-noise", type=float, default=0.0, metavar="SIGMA",
-                       help="add fixed grain (standard deviation in grey levels) so frames compress like a real camera's")
+                       help="add fixed grain (standard deviation in grey levels) so frames compress like a "
+                            "real camera's")
 
 
 def from_arguments(args: argparse.Namespace, context) -> CameraSim:

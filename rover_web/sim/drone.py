@@ -20,8 +20,8 @@ manoeuvre takes --drone-transition-s, so tests can make the drone fast.
 from __future__ import annotations
 
 import argparse
-import sys
 import math
+import sys
 import threading
 import time
 from collections import deque
@@ -76,7 +76,7 @@ class DroneModel:
         if leg is None:
             return self._position
         f = min(1.0, max(0.0, (now - leg.t0) / leg.duration_s))
-        return tuple(a + (b - a) * f for a, b in zip(leg.start, leg.end))  # type: ignore[return-value]
+        return tuple(a + (b - a) * f for a, b in zip(leg.start, leg.end, strict=True))  # type: ignore[return-value]
 
     def step(self, now: float) -> bool:
         """Finish the current manoeuvre if its time is up; True if the status changed."""

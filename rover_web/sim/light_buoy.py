@@ -14,16 +14,16 @@ The code it chose is the truth the tests compare with: published on /light_buoy/
 from __future__ import annotations
 
 import argparse
-import sys
 import random
+import sys
 import time
-from typing import Sequence
+from collections.abc import Sequence
 
 from rclpy.node import Node
 from std_msgs.msg import Empty, String
 
-from rover_web.scan_the_code.light_sequence import BLACK, CODE_LENGTH, parse_colours
 from rover_web.ros import qos
+from rover_web.scan_the_code.light_sequence import BLACK, CODE_LENGTH, parse_colours
 
 DEFAULT_COLOURS = ("red", "green", "blue", "yellow")
 # What a confused detector might report instead of the true colour, besides other colours and black.

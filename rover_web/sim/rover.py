@@ -14,9 +14,9 @@ navigating robot.
 from __future__ import annotations
 
 import argparse
-import sys
 import math
 import os
+import sys
 import time
 from dataclasses import dataclass
 

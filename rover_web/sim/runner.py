@@ -6,7 +6,7 @@ import argparse
 import signal
 import sys
 import threading
-from typing import Callable
+from collections.abc import Callable
 
 import rclpy
 from rclpy.context import Context

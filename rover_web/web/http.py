@@ -116,13 +116,15 @@ def _guard():
     host = request.environ.get("HTTP_HOST", "")
     if not host_is_trusted(host, config["ROVER_WEB_TRUSTED_HOSTS"]):
         return error_response(400, "untrusted_host",
-                              f"Host {host[:80]!r} is not in ROVER_WEB_TRUSTED_HOSTS; add it there to reach the GUI by that name")
+                              f"Host {host[:80]!r} is not in ROVER_WEB_TRUSTED_HOSTS; "
+                              "add it there to reach the GUI by that name")
     is_websocket = request.headers.get("Upgrade", "").lower() == "websocket"
     if request.method in STATE_CHANGING or is_websocket:
         origin = request.headers.get("Origin")
         if origin and not origin_allowed(origin, host, config["ROVER_WEB_ALLOWED_ORIGINS"]):
             return error_response(403, "foreign_origin",
-                                  f"requests from {origin[:80]} may not control this robot; add it to ROVER_WEB_ALLOWED_ORIGINS")
+                                  f"requests from {origin[:80]} may not control this robot; "
+                                  "add it to ROVER_WEB_ALLOWED_ORIGINS")
     limit = config["ROVER_WEB_MAX_BODY_BYTES"]
     if request.content_length is not None and request.content_length > limit:
         # Refuse before routing or reading, whatever the route does with its body.

@@ -5,6 +5,7 @@ from __future__ import annotations
 from flask import Blueprint, render_template
 
 from rover_web.core.state import current_rover
+
 from .status import build_status
 
 bp = Blueprint("pages", __name__)

@@ -8,8 +8,9 @@ import time
 from flask import Blueprint, Response, request, stream_with_context
 
 from rover_web.core.state import current_rover
-from rover_web.web.connection import peer_gone
 from rover_web.events.hub import TooManyClients
+from rover_web.web.connection import peer_gone
+
 from .http import ApiError
 
 bp = Blueprint("sse", __name__)
@@ -22,11 +23,13 @@ _LIVENESS_CHECK_S = 1.0
 def _parse_channels(raw: str, known: frozenset[str]) -> list[str]:
     channels = [c for c in (part.strip() for part in raw.split(",")) if c]
     if not channels:
-        raise ApiError(400, "missing_channels", f"name channels, e.g. ?channels=status; known: {', '.join(sorted(known))}")
+        raise ApiError(400, "missing_channels",
+                       f"name channels, e.g. ?channels=status; known: {', '.join(sorted(known))}")
     unknown = [c for c in channels if c not in known]
     if unknown:
         raise ApiError(400, "unknown_channel",
-                       f"unknown channel(s) {', '.join(c[:32] for c in unknown[:5])}; known: {', '.join(sorted(known))}")
+                       f"unknown channel(s) {', '.join(c[:32] for c in unknown[:5])}; "
+                       f"known: {', '.join(sorted(known))}")
     return channels
 
 

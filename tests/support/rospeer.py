@@ -11,9 +11,8 @@ import sys
 import threading
 import time
 from collections import defaultdict
-from pathlib import Path
-from rover_web.config import ROOT
 
+from rover_web.config import ROOT
 
 
 def subprocess_env(**extra: str) -> dict[str, str]:
@@ -136,7 +135,7 @@ class RosPeer:
     def close(self) -> None:
         stop_piped(self.proc, json.dumps({"op": "quit"}))
 
-    def __enter__(self) -> "RosPeer":
+    def __enter__(self) -> RosPeer:
         return self
 
     def __exit__(self, *exc) -> None:

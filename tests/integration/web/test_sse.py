@@ -56,7 +56,7 @@ def test_keepalive_comment_when_idle(live_server_factory, sse_client):
     server = live_server_factory(ROVER_WEB_SSE_KEEPALIVE_S=0.2, ROVER_WEB_STATUS_PERIOD_S=60)
     stream = sse_client(server.url + "/api/events?channels=status")
     assert wait_until(lambda: len(stream.comments) >= 3, timeout=5)
-    gaps = [b[0] - a[0] for a, b in zip(stream.comments, stream.comments[1:])]
+    gaps = [b[0] - a[0] for a, b in zip(stream.comments, stream.comments[1:], strict=False)]
     assert all(g < 1.0 for g in gaps)
     assert stream.comments[0][1] == " keep-alive" or "keep-alive" in stream.comments[0][1]
 

@@ -64,9 +64,12 @@ def main():
             if op == "sub":
                 topic = cmd["topic"]
 
-                def callback(msg, topic=topic):
+                max_items = cmd.get("max_items", 64)
+
+                # Bound now: `cmd` is the next command by the time a message arrives.
+                def callback(msg, topic=topic, max_items=max_items):
                     t = time.monotonic()
-                    emit(event="msg", topic=topic, t=t, msg=message_to_dict(msg, max_items=cmd.get("max_items", 64)))
+                    emit(event="msg", topic=topic, t=t, msg=message_to_dict(msg, max_items=max_items))
 
                 subs[topic] = node.create_subscription(message_class(cmd["type"]), topic, callback,
                                                        profile(cmd.get("qos", "default")))

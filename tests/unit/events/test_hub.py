@@ -3,7 +3,8 @@ import threading
 import time
 
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from rover_web.events.hub import EventHub, TooManyClients
 

@@ -18,7 +18,7 @@ def test_full_circle_returns_home():
     d = DiffDrive(cmd_timeout_s=100)
     d.command(1.0, 1.0, now=0.0)
     steps = 1000
-    for i in range(steps):
+    for _ in range(steps):
         d.step(2 * math.pi / steps, now=0.0)
     assert math.isclose(d.x, 0.0, abs_tol=1e-9) and math.isclose(d.y, 0.0, abs_tol=1e-9)
 

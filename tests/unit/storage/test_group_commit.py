@@ -84,10 +84,14 @@ def test_a_refused_change_rolls_back_alone(db):
         conn.execute("INSERT INTO t VALUES (3)")
         raise ValueError("no")
 
+    def good(conn):
+        return conn.execute("INSERT INTO t VALUES (4)") and 4
+
     threads = [threading.Thread(target=run, args=("blocker", blocker))]
     threads[0].start()
     time.sleep(0.1)
-    for name, fn in [("bad", bad), ("refused", refused), ("good", lambda c: c.execute("INSERT INTO t VALUES (4)") and 4)]:
+
+    for name, fn in [("bad", bad), ("refused", refused), ("good", good)]:
         threads.append(threading.Thread(target=run, args=(name, fn)))
         threads[-1].start()
     time.sleep(0.2)
