@@ -11,6 +11,7 @@ from __future__ import annotations
 from typing import Any
 
 from rover_web.web.validate import InvalidInput
+
 from .store import Mission, check_label, check_lat, check_lng
 
 MEDIA_TYPE = "application/geo+json"

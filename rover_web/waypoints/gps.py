@@ -20,7 +20,7 @@ STATUS_NAMES = {-1: "no fix", 0: "fix", 1: "SBAS fix", 2: "GBAS fix"}
 
 @dataclass(frozen=True)
 class FixReading:
-    """One NavSatFix, as plain numbers (see rover_web.ros.waypoints_msgs.fix_reading)."""
+    """One NavSatFix, as plain numbers (see msgs.fix_reading)."""
 
     status: int
     lat: float

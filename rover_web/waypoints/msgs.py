@@ -5,8 +5,9 @@ from __future__ import annotations
 import math
 from typing import Sequence
 
-from .gps import FixReading
 from rover_web.ros.typesupport import message_class
+
+from .gps import FixReading
 
 FLOAT64_MULTI_ARRAY = "std_msgs/msg/Float64MultiArray"
 NAV_SAT_FIX = "sensor_msgs/msg/NavSatFix"
@@ -37,7 +38,7 @@ def mission_message(points: Sequence[tuple[float, float]]):
 
 
 def fix_reading(msg) -> FixReading:
-    """The numbers the map needs from a NavSatFix; judging them is rover_web.gps's job."""
+    """The numbers the map needs from a NavSatFix; judging them is gps.py's job."""
     sigma = None
     if msg.position_covariance_type != 0:  # COVARIANCE_TYPE_UNKNOWN
         cov = msg.position_covariance

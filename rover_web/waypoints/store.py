@@ -1,7 +1,7 @@
 """The mission: an ordered list of GPS waypoints kept in SQLite. Pure Python, no Flask, no rclpy.
 
 Every change runs in a transaction (BEGIN IMMEDIATE ... COMMIT with synchronous=FULL; concurrent
-changes share one, see group_commit.py, each in its own savepoint) and a method returns only
+changes share one, see storage/group_commit.py, each in its own savepoint) and a method returns only
 after that commit, so a change the caller acknowledges is on disk, and a crash leaves either the
 whole change or none of it.
 The table's CHECK constraints repeat the input rules, so even a bug cannot store a waypoint the
@@ -53,6 +53,10 @@ class WaypointNotFound(LookupError):
 
 class StaleRevision(Exception):
     """The client acted on a mission that has changed since it read it."""
+
+
+class EmptyMission(Exception):
+    """There is no waypoint to send."""
 
 
 @dataclass(frozen=True)
@@ -118,14 +122,14 @@ def _row(row) -> Waypoint:
 
 
 class WaypointStore:
-    """The stored mission. `db` is a rover_web.db.Database; methods are safe from any thread."""
+    """The stored mission. `db` is a rover_web.storage.db.Database; methods are safe from any thread."""
 
     def __init__(self, db, max_waypoints: int):
         self.db = db
         self.max_waypoints = max_waypoints
         db.ensure_schema(SCHEMA)
         # Every change goes through one committer thread: concurrent writers share a transaction
-        # and its fsync, and each is answered only after that commit (rover_web.group_commit).
+        # and its fsync, and each is answered only after that commit (rover_web.storage.group_commit).
         self._committer = GroupCommitter(db, name="waypoints-commit")
         self._commit = self._committer.run
 

@@ -6,6 +6,7 @@ import sqlite3
 
 import pytest
 
+from rover_web.waypoints.service import WaypointsService
 from tests.support.waypoint_helpers import stored_rows
 
 
@@ -205,7 +206,7 @@ def test_schema_has_the_documented_checks(wp_app, api):
 
 
 def test_a_write_during_shutdown_is_503_not_a_crash(wp_app, api):
-    wp_app.extensions["rover_web.waypoints"].store.close()  # what shutdown does first
+    wp_app.extensions["rover_web"].feature(WaypointsService).store.close()  # what shutdown does first
     r = api.post("/waypoints", json={"lng": 1.0, "lat": 2.0})
     assert r.status_code == 503 and r.get_json()["error"] == "shutting_down"
     assert stored_rows(db_path(wp_app)) == []

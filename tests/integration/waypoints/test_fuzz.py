@@ -12,6 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from rover_web import create_app
+from rover_web.waypoints.service import WaypointsService
 from tests.support.rospeer import RosPeer
 from tests.support.waypoint_helpers import FLOAT64_MULTI_ARRAY
 
@@ -62,7 +63,7 @@ class Harness:
                                "ROVER_WEB_MAX_WAYPOINTS": MAX_WAYPOINTS})
         self.db_path = db_path
         self.client = self.app.test_client()
-        self.store = self.app.extensions["rover_web.waypoints"].store
+        self.store = self.app.extensions["rover_web"].feature(WaypointsService).store
         self.peer = RosPeer("fuzz_listener")
         for topic in ("/waypoints", "/mission"):
             self.peer.subscribe(topic, FLOAT64_MULTI_ARRAY, qos=1000)  # a listener that must not drop any

@@ -5,6 +5,7 @@ import sqlite3
 import click
 import pytest
 
+from rover_web.basemap.fetch import TooManyTiles, check_url_template, fetch_tiles, parse_bbox, parse_zoom
 from rover_web.basemap.tile_store import (
     FolderTiles,
     MBTiles,
@@ -16,7 +17,6 @@ from rover_web.basemap.tile_store import (
     tile_y,
     valid_tile,
 )
-from rover_web.basemap import TooManyTiles, check_url_template, fetch_tiles, parse_bbox, parse_zoom
 
 PNG = b"\x89PNG\r\n\x1a\n" + b"rest"
 JPG = b"\xff\xd8\xff\xe0" + b"rest"

@@ -15,7 +15,7 @@ from rover_web.scan_the_code.light_sequence import (
     classify,
     parse_colours,
 )
-from rover_web.scan_the_code import CODE_CHANNEL, STATE_CHANNEL, ScanTheCode
+from rover_web.scan_the_code.service import CODE_CHANNEL, STATE_CHANNEL, ScanTheCodeService
 
 COLOURS = ("red", "green", "blue", "yellow")
 
@@ -396,7 +396,7 @@ class Clock:
 
 def test_glue_publishes_state_on_change_and_announces_each_confirmed_code():
     hub, clock, published = EventHub(), Clock(), []
-    feature = ScanTheCode(LightSequence(COLOURS), hub, published.append, clock=clock, wall_clock=clock)
+    feature = ScanTheCodeService(LightSequence(COLOURS), hub, published.append, clock=clock, wall_clock=clock)
     assert hub.latest(STATE_CHANNEL)["boxes"] == [BLACK] * 3
     with hub.subscribe([STATE_CHANNEL, CODE_CHANNEL]) as sub:
         sub.snapshot()
@@ -419,7 +419,7 @@ def test_glue_survives_a_failing_code_publisher_and_reports_staleness():
     def broken(colours):
         raise RuntimeError("publisher destroyed")
 
-    feature = ScanTheCode(LightSequence(COLOURS, stale_after_s=1.0), hub, broken, clock=clock, wall_clock=clock)
+    feature = ScanTheCodeService(LightSequence(COLOURS, stale_after_s=1.0), hub, broken, clock=clock, wall_clock=clock)
     for text in ("red", "green", "blue", "black"):
         clock.t += 0.1
         feature.observe(text)

@@ -1,0 +1,52 @@
+"""The installed basemap: the tile store ROVER_WEB_MAP_TILES names, and the raster source the page gets."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from rover_web.config import ROOT
+
+from .tile_store import TileStoreError, open_tile_store
+
+TILE_URL = "/tiles/{z}/{x}/{y}"
+
+
+def store_path(config) -> Path | None:
+    value = config.get("ROVER_WEB_MAP_TILES")
+    if not value:
+        return None
+    path = Path(value).expanduser()
+    return path if path.is_absolute() else ROOT / path
+
+
+def installed_store(config):
+    """The configured store if it exists and holds tiles, else None (the map runs without basemap)."""
+    path = store_path(config)
+    if path is None:
+        return None
+    store = open_tile_store(path)
+    if store.exists():
+        return store
+    store.close()
+    return None
+
+
+def basemap(config) -> dict | None:
+    """What the page's raster source needs, or None when no basemap is installed."""
+    store = installed_store(config)
+    if store is None:
+        return None
+    try:
+        meta = store.metadata()
+    except TileStoreError:
+        return None
+    finally:
+        store.close()
+    source = {"tiles": [TILE_URL], "tileSize": 256, "attribution": meta["attribution"], "name": meta["name"]}
+    if meta["minzoom"] is not None:
+        source["minzoom"] = meta["minzoom"]
+    if meta["maxzoom"] is not None:
+        source["maxzoom"] = meta["maxzoom"]
+    if meta["bounds"]:
+        source["bounds"] = meta["bounds"]
+    return source

@@ -1,0 +1,75 @@
+"""The waypoints feature's per-app object: the stored mission, its two topics and the robot's fix."""
+
+from __future__ import annotations
+
+from rover_web.basemap.source import basemap
+from rover_web.core.state import Rover
+
+from .broadcaster import MissionBroadcaster
+from .gps import FixReading, GpsTrack
+from .msgs import FLOAT64_MULTI_ARRAY, mission_message, waypoint_message
+from .store import EmptyMission, StaleRevision, Waypoint, WaypointStore
+
+FIX_CHANNEL = "fix"
+FIX_CHANNEL_MAX_HZ = 5.0
+# Every waypoint is a command the robot must not miss: keep enough history that a subscriber a
+# few hundred milliseconds behind a burst of clicks (or a script) still receives all of them.
+WAYPOINT_QOS_DEPTH = 1000
+
+
+class WaypointsService:
+    def __init__(self, rover: Rover):
+        config = rover.config
+        self.config = config
+        self.store = WaypointStore(rover.db, config["ROVER_WEB_MAX_WAYPOINTS"])
+        runtime = rover.runtime
+        self.waypoint_topic = config["ROVER_WEB_WAYPOINTS_TOPIC"]
+        self.mission_topic = config["ROVER_WEB_MISSION_TOPIC"]
+        self.waypoint_pub = runtime.publisher(FLOAT64_MULTI_ARRAY, self.waypoint_topic, qos=WAYPOINT_QOS_DEPTH)
+        self.mission_pub = runtime.publisher(FLOAT64_MULTI_ARRAY, self.mission_topic, qos=10)
+        self.hub = rover.hub
+        self.track = GpsTrack(config["ROVER_WEB_FIX_TRACK_POINTS"])
+        self.broadcaster = MissionBroadcaster(self.store, rover.hub)
+
+    def on_fix(self, reading: FixReading) -> None:
+        state = self.track.update(reading)
+        self.hub.publish_throttled(FIX_CHANNEL, state, FIX_CHANNEL_MAX_HZ)
+
+    # --- changes ---
+
+    def add(self, lng: float, lat: float, label: str = "") -> Waypoint:
+        # Published once committed, by the committer thread: /waypoints carries the waypoints in
+        # the mission's order even when several browsers or scripts add at the same moment.
+        waypoint, _revision = self.store.add(lng, lat, label, announce=self._announce)
+        self.broadcaster.changed()
+        return waypoint
+
+    def _announce(self, waypoint: Waypoint) -> None:
+        self.waypoint_pub.publish(waypoint_message(waypoint.lng, waypoint.lat))
+
+    def changed(self) -> None:
+        self.broadcaster.changed()
+
+    def send_mission(self, expected_revision: int | None) -> dict:
+        mission = self.store.mission()
+        if expected_revision is not None and expected_revision != mission.revision:
+            raise StaleRevision(mission.revision)
+        if not mission.waypoints:
+            raise EmptyMission()
+        self.mission_pub.publish(mission_message([(w.lng, w.lat) for w in mission.waypoints]))
+        return {"sent": len(mission.waypoints), "topic": self.mission_topic, **mission.to_dict()}
+
+    # --- views' data ---
+
+    def map_config(self) -> dict:
+        config = self.config
+        return {
+            "place": config["ROVER_WEB_MAP_PLACE_NAME"],
+            "center": [config["ROVER_WEB_MAP_CENTER_LNG"], config["ROVER_WEB_MAP_CENTER_LAT"]],
+            "zoom": config["ROVER_WEB_MAP_ZOOM"],
+            "basemap": basemap(config),
+            "max_waypoints": self.store.max_waypoints,
+        }
+
+    def panel_context(self) -> dict:
+        return {"mission": self.store.mission(), "map": self.map_config(), "fix": self.track.state()}
