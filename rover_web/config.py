@@ -79,6 +79,17 @@ SETTINGS: tuple[Setting, ...] = (
             "topics whose freshness defines the server-robot link in the health bar"),
     Setting("ODOM_TOPIC", "/odom", "topic", "nav_msgs/Odometry the dashboard shows speed from"),
     Setting("ODOM_MAX_HZ", 10.0, "float", "most `odom` channel updates a second sent to browsers", 0.1, 1000),
+    # --- e-stop ---
+    Setting("ESTOP_TOPIC", "/e_stop", "topic",
+            "std_msgs/Bool the e-stop publishes (reliable, transient local): true engaged, false released"),
+    Setting("ESTOP_REPEAT_S", 1.0, "float", "how often the e-stop state is republished on ROVER_WEB_ESTOP_TOPIC",
+            0.05, 60),
+    Setting("ESTOP_CANCEL_ACTIONS", ["/navigate_to_pose", "/navigate_through_poses", "/follow_waypoints",
+                                     "/follow_gps_waypoints"], "list",
+            "actions whose goals are all canceled (action_msgs/srv/CancelGoal) when the e-stop engages"),
+    Setting("MAX_STREAMS", 48, "int",
+            "most long-lived streams (SSE, MJPEG, topic echo, teleop sockets) at once, 503 beyond; keep it "
+            "below the server's thread count so short requests such as the e-stop always find a thread", 1, 4096),
     # --- teleop ---
     Setting("CMD_VEL_TOPIC", "/cmd_vel", "topic", "velocity command topic"),
     Setting("CMD_VEL_STAMPED", False, "bool",

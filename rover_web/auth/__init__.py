@@ -20,9 +20,10 @@ from rover_web.core.state import Rover
 from . import routes
 from .cli import init_cli
 from .identity import Anonymous, SignedIn, current_identity, may, signed_in_name
+from .routes import require_role
 from .service import AuthService, secret_key
 
-__all__ = ["init_app", "init_cli", "current_identity", "may", "signed_in_name", "AuthService"]
+__all__ = ["init_app", "init_cli", "current_identity", "may", "require_role", "signed_in_name", "AuthService"]
 
 BEARER = "bearer "
 

@@ -22,7 +22,7 @@ READ_METHODS = frozenset({"GET", "HEAD", "OPTIONS"})
 # Reachable without signing in: the sign-in form itself and the files it needs.
 PUBLIC_ENDPOINTS = frozenset({"auth.login_form", "auth.login", "static"})
 # Any signed-in user, whatever the method.
-ANY_USER_ENDPOINTS = frozenset({"auth.logout", "teleop.estop_set"})  # estop_set: the view checks release
+ANY_USER_ENDPOINTS = frozenset({"auth.logout", "estop.estop_set"})  # estop_set: the view checks release
 ADMIN_ENDPOINT_PREFIX = "auth.admin_"
 
 

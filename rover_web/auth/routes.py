@@ -47,7 +47,7 @@ def _forbidden(needed: str):
                           f"this needs the {needed} role; {current_user.name} is a {current_user.role}")
 
 
-def require(role: str) -> None:
+def require_role(role: str) -> None:
     """For views whose rule depends on the request body (releasing the e-stop needs an operator)."""
     if _service().required and not role_allows(current_user.role, role):
         raise ApiError(403, "forbidden", f"this needs the {role} role; {current_user.name} is a {current_user.role}")

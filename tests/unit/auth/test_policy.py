@@ -12,7 +12,7 @@ from rover_web.auth.policy import is_loopback, required_role, role_allows, sign_
     ("GET", "/", "pages.dashboard", "viewer"),
     ("GET", "/api/events", "sse.events", "viewer"),
     ("GET", "/stream", "camera.stream", "viewer"),
-    ("POST", "/api/estop", "teleop.estop_set", "viewer"),
+    ("POST", "/api/estop", "estop.estop_set", "viewer"),
     ("POST", "/logout", "auth.logout", "viewer"),
     ("GET", "/ws/teleop", "teleop_socket", "operator"),
     ("POST", "/api/teleop", "teleop.teleop_command", "operator"),

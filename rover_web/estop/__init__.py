@@ -1,0 +1,52 @@
+"""The e-stop: one latch that stops everything the GUI can start, reachable from every page.
+
+  GET  /api/estop    the latch: engaged, since, by, via, persisted, and the goal cancels' outcome
+  POST /api/estop    {"engaged": true} engages (any signed-in user), {"engaged": false} releases (operator)
+  SSE  estop         the latch whenever it changes
+  ROS  ROVER_WEB_ESTOP_TOPIC (std_msgs/Bool, reliable, transient local), republished every
+       ROVER_WEB_ESTOP_REPEAT_S; CancelGoal to every action in ROVER_WEB_ESTOP_CANCEL_ACTIONS on engage.
+Other features gate motion with `rover.feature(EStopService).check_motion()` and react with
+`on_engage` / `on_release`.
+"""
+
+from __future__ import annotations
+
+from flask import Flask
+
+from rover_web.config import TOPIC_PATTERN, ConfigError
+from rover_web.core.state import Rover
+from rover_web.ros.actions import GoalCanceller
+
+from . import msgs, routes
+from .service import CHANNEL, EStopEngaged, EStopService
+from .store import EStopStore
+
+__all__ = ["init_app", "EStopService", "EStopEngaged"]
+
+
+def init_app(app: Flask, rover: Rover) -> None:
+    config = rover.config
+    actions = config["ROVER_WEB_ESTOP_CANCEL_ACTIONS"]
+    for name in actions:
+        if not isinstance(name, str) or not TOPIC_PATTERN.match(name):
+            raise ConfigError(f"ROVER_WEB_ESTOP_CANCEL_ACTIONS: {name!r} is not an action name such as "
+                              "/navigate_to_pose")
+    flag = rover.runtime.publisher(msgs.MSG_TYPE, config["ROVER_WEB_ESTOP_TOPIC"], qos="latched")
+    canceller = GoalCanceller(rover.runtime, actions) if actions else None
+    rover.hub.register(CHANNEL)
+    estop = EStopService(
+        EStopStore(rover.db),
+        zero=rover.cmd_vel.zero,
+        publish_flag=lambda engaged: flag.publish(msgs.flag(engaged)),
+        cancel_goals=canceller.cancel_all if canceller else None,
+        on_change=lambda state: rover.hub.publish(CHANNEL, state))
+    rover.add_feature(estop)
+    app.register_blueprint(routes.bp)
+    rover.hub.publish(CHANNEL, estop.state())
+    estop.republish()  # a late joiner gets the latch from the transient-local history at once
+    rover.every(config["ROVER_WEB_ESTOP_REPEAT_S"], estop.republish, name="estop-republish")
+    rover.every(1.0 / config["ROVER_WEB_TELEOP_RATE_HZ"], estop.hold, name="estop-hold-zero")
+
+    @app.context_processor
+    def _estop_context():
+        return {"estop_state": estop.state()}

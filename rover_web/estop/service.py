@@ -1,0 +1,193 @@
+"""The e-stop: one latch that stops everything the GUI can start.
+
+Engaging stops the robot before anything else, without waiting on a lock that I/O holds: zero
+velocity goes out, every feature's engage hook runs (teleop drops its drivers, panels send their
+`on_estop` command), `/e_stop` says true, and every navigation action is asked to cancel its goals.
+The latch is written to disk after that. While engaged, zero velocity goes out at the teleop rate
+and every request that would publish motion is refused (`check_motion`).
+
+Releasing is written to disk first, and only then allowed: if an engage arrives while that write
+is under way, the release is abandoned and the e-stop stays engaged.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+
+from .store import EStopStore
+
+log = logging.getLogger(__name__)
+
+CHANNEL = "estop"
+
+
+class EStopEngaged(Exception):
+    """A request that would move the robot while the e-stop is engaged."""
+
+    def __init__(self, state: dict):
+        by = f" by {state['by']}" if state.get("by") else ""
+        super().__init__(f"the e-stop is engaged{by}: release it before sending motion")
+        self.state = state
+
+
+class ReleaseRefused(Exception):
+    """The release could not be made safe (not recorded, or engaged again meanwhile)."""
+
+    def __init__(self, code: str, message: str, status: int):
+        super().__init__(message)
+        self.code, self.status = code, status
+
+
+class EStopService:
+    def __init__(self, store: EStopStore, *, zero: Callable[[], None], publish_flag: Callable[[bool], None],
+                 cancel_goals: Callable[[Callable[[list[dict]], None]], None] | None,
+                 on_change: Callable[[dict], None], clock: Callable[[], float] = time.time):
+        self._store = store
+        self._zero = zero
+        self._publish_flag = publish_flag
+        self._cancel_goals = cancel_goals
+        self._on_change = on_change
+        self._clock = clock
+        loaded = store.load()
+        self._engaged = bool(loaded["engaged"])
+        self._state = {**loaded, "persisted": True, "cancel": None}
+        self._epoch = 0  # +1 per engage, so a release can tell that one came while it wrote
+        self._lock = threading.Lock()  # guards the state in memory; never held across I/O
+        self._release_lock = threading.Lock()  # one release at a time (engaging never takes it)
+        self._engage_hooks: list[Callable[[str], None]] = []
+        self._release_hooks: list[Callable[[str], None]] = []
+
+    # --- for other features ---
+
+    @property
+    def engaged(self) -> bool:
+        return self._engaged
+
+    def check_motion(self) -> None:
+        """Raise EStopEngaged if motion may not be published now."""
+        if self._engaged:
+            raise EStopEngaged(self.state())
+
+    def on_engage(self, hook: Callable[[str], None]) -> None:
+        """hook(by) runs right after every engage, after zero velocity went out."""
+        self._engage_hooks.append(hook)
+
+    def on_release(self, hook: Callable[[str], None]) -> None:
+        self._release_hooks.append(hook)
+
+    def state(self) -> dict:
+        with self._lock:
+            return dict(self._state)
+
+    # --- engage and release ---
+
+    def engage(self, by: str, via: str = "api") -> dict:
+        with self._lock:
+            first = not self._engaged
+            self._engaged = True
+            self._epoch += 1
+            if first:
+                self._state = {"engaged": True, "since": self._clock(), "by": by, "via": via, "persisted": None,
+                               "cancel": None}
+            state = dict(self._state)
+        self._stop_everything(by)
+        if not first:
+            return self.state()
+        log.warning("e-stop engaged by %s (%s)", by, via)
+        if self._cancel_goals is not None:
+            self._cancel_goals(self._goals_canceled)
+        persisted = self._persist(state)
+        with self._lock:
+            if self._state.get("since") == state["since"]:
+                self._state["persisted"] = persisted
+            state = dict(self._state)
+        self._on_change(state)
+        return state
+
+    def release(self, by: str) -> dict:
+        with self._release_lock:
+            with self._lock:
+                if not self._engaged:
+                    return dict(self._state)
+                epoch = self._epoch
+            released = {"engaged": False, "since": self._clock(), "by": by}
+            try:
+                self._store.save(released)
+            except Exception:
+                log.exception("could not record the e-stop release")
+                raise ReleaseRefused("estop_not_recorded", "the release could not be written to the database; "
+                                     "the e-stop stays engaged", 503) from None
+            with self._lock:
+                if self._epoch != epoch:  # engaged again while the release was written
+                    again = dict(self._state)
+                else:
+                    self._engaged = False
+                    self._state = {**released, "via": None, "persisted": True, "cancel": None}
+                    again = None
+            if again is not None:
+                self._persist(again)  # the disk must not keep the abandoned release
+                raise ReleaseRefused("estop_engaged", "the e-stop was engaged again while releasing", 409)
+        log.warning("e-stop released by %s", by)
+        for hook in self._release_hooks:
+            self._run_hook(hook, by)
+        self._publish_flag_safely(False)
+        state = self.state()
+        self._on_change(state)
+        return state
+
+    # --- while engaged ---
+
+    def hold(self) -> None:
+        """Called at the teleop rate: zero velocity keeps going out while engaged."""
+        if self._engaged:
+            self._zero()
+
+    def republish(self) -> None:
+        """Called every ROVER_WEB_ESTOP_REPEAT_S: a safety node that missed a change learns it."""
+        self._publish_flag_safely(self._engaged)
+
+    # --- internals ---
+
+    def _stop_everything(self, by: str) -> None:
+        try:
+            self._zero()
+        except Exception:
+            log.exception("e-stop: zero velocity could not be published")
+        for hook in self._engage_hooks:
+            self._run_hook(hook, by)
+        self._publish_flag_safely(True)
+
+    def _persist(self, state: dict) -> bool:
+        try:
+            self._store.save(state)
+            return True
+        except Exception:
+            log.exception("e-stop engaged but not recorded on disk")
+            return False
+
+    def _goals_canceled(self, outcomes: list[dict]) -> None:
+        with self._lock:
+            if not self._engaged:
+                return
+            self._state["cancel"] = outcomes
+            state = dict(self._state)
+        for outcome in outcomes:
+            if outcome["result"] not in ("not_running", "no_goals"):
+                log.warning("e-stop: cancel of %s: %s", outcome["action"], outcome["result"])
+        self._on_change(state)
+
+    def _publish_flag_safely(self, engaged: bool) -> None:
+        try:
+            self._publish_flag(engaged)
+        except Exception:
+            log.exception("e-stop: %s could not be published", "true" if engaged else "false")
+
+    @staticmethod
+    def _run_hook(hook: Callable[[str], None], by: str) -> None:
+        try:
+            hook(by)
+        except Exception:
+            log.exception("e-stop hook %r failed", hook)

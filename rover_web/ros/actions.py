@@ -1,0 +1,74 @@
+"""Cancelling every goal of running action servers (Nav2's navigate_to_pose and friends).
+
+An action server answers `action_msgs/srv/CancelGoal` on `<action>/_action/cancel_goal`; a
+request with a zero goal id and a zero stamp cancels every goal it has accepted. Clients are made
+once, at start, so that discovery has happened long before an e-stop needs them.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable
+
+from action_msgs.srv import CancelGoal
+
+RETURN_CODES = {0: "canceled", 1: "rejected", 2: "no_goals", 3: "no_goals"}  # 2, 3: nothing to cancel
+
+
+class GoalCanceller:
+    def __init__(self, runtime, actions: list[str]):
+        self._runtime = runtime
+        self._clients = {name: runtime.node.create_client(CancelGoal, f"{name.rstrip('/')}/_action/cancel_goal")
+                         for name in actions}
+
+    @property
+    def actions(self) -> list[str]:
+        return list(self._clients)
+
+    def cancel_all(self, on_done: Callable[[list[dict]], None], timeout_s: float = 1.0) -> None:
+        """Ask every running action server to cancel all its goals, without waiting for the answers:
+        `on_done` gets one outcome per action when all have answered or `timeout_s` has passed."""
+        outcomes: dict[str, dict] = {}
+        pending: list = []
+        lock = threading.Lock()
+        finished = threading.Event()
+
+        def finish() -> None:
+            with lock:
+                if finished.is_set():
+                    return
+                finished.set()
+                for name, _ in pending:
+                    outcomes.setdefault(name, {"action": name, "result": "no_answer"})
+                result = [outcomes[name] for name in self._clients]
+            on_done(result)
+
+        for name, client in self._clients.items():
+            if not client.service_is_ready():
+                outcomes[name] = {"action": name, "result": "not_running"}
+                continue
+            future = client.call_async(CancelGoal.Request())  # zero id, zero stamp: every goal
+            pending.append((name, future))
+
+        def answered(name: str, future) -> None:
+            try:
+                response = future.result()
+                outcome = {"action": name, "result": RETURN_CODES.get(response.return_code, "error"),
+                           "goals": len(response.goals_canceling)}
+            except Exception as exc:  # the server vanished mid-call
+                outcome = {"action": name, "result": "error", "detail": str(exc)[:200]}
+            with lock:
+                outcomes[name] = outcome
+                done = all(n in outcomes for n, _ in pending)
+            if done:
+                finish()
+
+        if not pending:
+            finish()
+            return
+        for name, future in pending:
+            future.add_done_callback(lambda f, name=name: answered(name, f))
+        self._runtime.executor.wake()
+        timer = threading.Timer(timeout_s, finish)
+        timer.daemon = True
+        timer.start()
