@@ -8,7 +8,9 @@ import os
 bind = f"{os.environ.get('ROVER_WEB_HOST', '127.0.0.1')}:{os.environ.get('ROVER_WEB_PORT', '5000')}"
 workers = 1  # every worker would be a separate ROS node; never raise this
 worker_class = "gthread"
-threads = 64  # each open page holds one thread (its SSE stream) plus one per WebSocket
+# Each open stream (SSE, MJPEG, topic echo, teleop socket) holds a thread; rover_web caps them at
+# ROVER_WEB_MAX_STREAMS, so these 16 more threads are always there for short requests: the e-stop.
+threads = int(os.environ.get("ROVER_WEB_MAX_STREAMS", "64")) + 16
 timeout = 0  # event streams are long-lived by design
 graceful_timeout = 5
 # HTTPS: the same certificate and key the demo uses (`flask --app rover_web tls self-signed` writes a pair).

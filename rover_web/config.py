@@ -87,7 +87,7 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("ESTOP_CANCEL_ACTIONS", ["/navigate_to_pose", "/navigate_through_poses", "/follow_waypoints",
                                      "/follow_gps_waypoints"], "list",
             "actions whose goals are all canceled (action_msgs/srv/CancelGoal) when the e-stop engages"),
-    Setting("MAX_STREAMS", 48, "int",
+    Setting("MAX_STREAMS", 64, "int",
             "most long-lived streams (SSE, MJPEG, topic echo, teleop sockets) at once, 503 beyond; keep it "
             "below the server's thread count so short requests such as the e-stop always find a thread", 1, 4096),
     # --- teleop ---

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 from flask import current_app
 
 from rover_web.core.loops import Loop, every
+from rover_web.core.streams import StreamLimit
 
 if TYPE_CHECKING:
     from rover_web.events.broadcast import Broadcaster
@@ -55,6 +56,7 @@ class Rover:
         self.cmd_vel = cmd_vel
         self.db = db
         self.broadcaster = broadcaster  # writes every SSE stream
+        self.streams = StreamLimit(config["ROVER_WEB_MAX_STREAMS"])  # SSE, MJPEG, echo and teleop sockets
         self.dashboard_panels: list[DashboardPanel] = []
         self.nav_links: list[tuple[str, str]] = [("Dashboard", "/")]
         self._features: dict[type, object] = {}

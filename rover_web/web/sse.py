@@ -10,6 +10,7 @@ from flask import Blueprint, Response, request, stream_with_context
 from rover_web.core.state import current_rover
 from rover_web.events.hub import TooManyClients
 from rover_web.web.connection import peer_gone
+from rover_web.web.streams import held_by, stream_slot
 
 from .http import ApiError
 
@@ -68,15 +69,18 @@ def events():
         last_event_id = int(last_id) if last_id else None
     except ValueError:
         last_event_id = None
+    slot = stream_slot("sse")
     try:
         subscription = hub.subscribe(channels, last_event_id)
     except TooManyClients as exc:
+        slot.release()
         raise ApiError(503, "too_many_streams", f"{exc}; close some tabs") from None
     keepalive_s = config["ROVER_WEB_SSE_KEEPALIVE_S"]
     sock = request.environ.get("werkzeug.socket") or request.environ.get("gunicorn.socket")
     retry = f"retry: {config['ROVER_WEB_SSE_RETRY_MS']}\n\n".encode()
     if sock is not None and request.environ.get("SERVER_PROTOCOL", "").startswith("HTTP/1."):
-        return _serve_on_socket(rover, sock, subscription, retry)
+        with slot:
+            return _serve_on_socket(rover, sock, subscription, retry)
 
     def stream():
         with subscription:
@@ -96,5 +100,5 @@ def events():
                 elif peer_gone(sock):
                     return
 
-    return Response(stream_with_context(stream()), mimetype="text/event-stream",
-                    headers={"Cache-Control": "no-cache", "X-Accel-Buffering": "no"})
+    return held_by(Response(stream_with_context(stream()), mimetype="text/event-stream",
+                            headers={"Cache-Control": "no-cache", "X-Accel-Buffering": "no"}), slot)

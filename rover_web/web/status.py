@@ -36,6 +36,7 @@ def build_status(rover: Rover) -> dict:
         "link_topics": config["ROVER_WEB_LINK_TOPICS"],
         "robot_link": link_state(topics, config["ROVER_WEB_LINK_TOPICS"]),
         "sse_clients": rover.hub.client_count,
+        "streams": rover.streams.snapshot(),
         "topics": topics,
     }
 

@@ -78,7 +78,7 @@ def test_client_count_returns_to_zero_after_disconnect(live_server, sse_client):
 
 
 def test_two_hundred_clients_with_bounded_memory(live_server_factory, sse_client):
-    server = live_server_factory(ROVER_WEB_SSE_MAX_CLIENTS=300)
+    server = live_server_factory(ROVER_WEB_SSE_MAX_CLIENTS=300, ROVER_WEB_MAX_STREAMS=300)
     hub = server.rover.hub
     hub.register("bench")
     process = psutil.Process()
