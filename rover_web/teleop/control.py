@@ -32,8 +32,9 @@ import secrets
 import threading
 import time
 from collections import Counter, deque
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 log = logging.getLogger(__name__)
 
@@ -433,7 +434,7 @@ class Repeater:
         self.controller = controller
         self._thread = threading.Thread(target=self._run, name="teleop-repeater", daemon=True)
 
-    def start(self) -> "Repeater":
+    def start(self) -> Repeater:
         self._thread.start()
         return self
 

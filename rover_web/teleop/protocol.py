@@ -20,8 +20,9 @@ from typing import NamedTuple
 
 import orjson
 
-from .control import SOURCES
 from rover_web.web.validate import InvalidInput, json_type, loads_strict, number, only_keys, text
+
+from .control import SOURCES
 
 CLOSE_UNSUPPORTED_DATA = 1003
 CLOSE_INVALID_PAYLOAD = 1007
@@ -60,7 +61,7 @@ def _loads(data: str):
     names the fault (non-finite numbers, bad syntax) as before. Where the two differ on what they
     accept, integers beyond 64 bits (orjson gives floats) and lone surrogates (orjson refuses),
     the frame's outcome cannot: no such value passes the checks below, and
-    tests/unit/test_teleop_protocol.py compares both decoders on any frame."""
+    tests/unit/teleop/test_protocol.py compares both decoders on any frame."""
     try:
         return orjson.loads(data)
     except orjson.JSONDecodeError:

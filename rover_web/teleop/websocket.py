@@ -13,7 +13,7 @@ The request thread (`TeleopSocket.serve`) keeps what may wait: every message to 
 state changes, error replies), the pings, and the close handshake. A client that has not
 answered one ping by the next loses the socket (1008) and control.
 
-No extension is agreed (teleop.py drops the offer before the handshake): permessage-deflate on
+No extension is agreed (routes.py drops the offer before the handshake): permessage-deflate on
 ~50-byte frames saves nothing and costs both ends zlib work on every frame.
 """
 

@@ -4,7 +4,7 @@ and built for sending. Pure Python, no I/O.
 Why not wsproto, which did the handshake: cold, as every 40 Hz joystick frame is (nothing in
 the process ran for 25 ms), its parser takes ~150 µs a frame on this machine and this one ~30 µs
 (bench/teleop.py and BENCHMARKS.md). The rules are the RFC's, checked against wsproto by
-tests/unit/test_ws_frames.py for any mix of frames and any split of the byte stream.
+tests/unit/teleop/test_ws_frames.py for any mix of frames and any split of the byte stream.
 """
 
 from __future__ import annotations

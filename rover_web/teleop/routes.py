@@ -1,0 +1,126 @@
+"""Teleop's views: the joystick WebSocket, REST drive commands, the e-stop, and the dashboard card's context.
+
+The WebSocket view is routed on the app by flask_sock in init_app (the blueprint is shared by
+every app); `offer_no_extensions` runs before its handshake.
+"""
+
+from __future__ import annotations
+
+from flask import Blueprint, jsonify, request
+
+from rover_web.core.state import current_feature, current_rover
+from rover_web.web.http import ApiError, error_response, json_body
+from rover_web.web.validate import InvalidInput, number, only_keys, text
+
+from .control import REST_COMMANDS, Refused
+from .service import EStopNotRecorded, TeleopService
+from .websocket import TeleopSocket
+
+NAME_MAX_LEN = 40
+
+bp = Blueprint("teleop", __name__)
+
+
+@bp.errorhandler(EStopNotRecorded)
+def estop_not_recorded(exc: EStopNotRecorded):
+    return error_response(503, "estop_not_recorded", str(exc))
+
+
+@bp.app_context_processor
+def teleop_context():
+    return {"teleop_state": current_feature(TeleopService).controller.state()}
+
+
+def operator_name(raw: str | None) -> str | None:
+    if not raw:
+        return None
+    name = " ".join(raw.split())[:NAME_MAX_LEN]
+    return name if name.isprintable() and name else None
+
+
+# --- WebSocket ---
+
+def teleop_socket(ws) -> None:
+    teleop = current_feature(TeleopService)
+    controller = teleop.controller
+    try:
+        session = controller.connect(operator_name(request.args.get("name")))
+        hello = {**controller.session_state(session, "connected"), "type": "hello", "session": session.id,
+                 "name": session.name, **teleop.hello()}
+        TeleopSocket(ws, controller, session, teleop.max_frame_bytes).serve(
+            hello, current_rover().stopping, teleop.config["ROVER_WEB_TELEOP_WS_PING_S"] or None)
+    finally:
+        ws.thread.attach(None)  # a reader that never got a TeleopSocket ends rather than wait forever
+
+
+def offer_no_extensions() -> None:
+    """Before the handshake: agree to no extension. Teleop frames are ~50 bytes, so
+    permessage-deflate would save nothing and cost zlib work on every frame at both ends; our
+    reader (ws_frames.py) reads plain frames and refuses compressed ones (1002)."""
+    if request.endpoint == "teleop_socket":
+        request.environ.pop("HTTP_SEC_WEBSOCKET_EXTENSIONS", None)
+
+
+# --- REST ---
+
+@bp.get("/api/teleop")
+def teleop_state():
+    return jsonify(current_feature(TeleopService).controller.state())
+
+
+@bp.post("/api/teleop")
+def teleop_command():
+    teleop = current_feature(TeleopService)
+    config = teleop.config
+    body = json_body()
+    if body.get("command") == "stop":  # stop always wins, whatever else the body says
+        teleop.controller.rest_stop()
+        return jsonify(command="stop", linear_mps=0.0, angular_rps=0.0, duration_s=0.0)
+    try:
+        only_keys(body, {"command", "speed", "duration_s"})
+        for key in ("speed", "duration_s"):
+            if key in body and body[key] is None:
+                raise InvalidInput(f"'{key}' must be a number, got null", "bad_type")
+        command = text(body, "command", max_len=20)
+        if command not in REST_COMMANDS:
+            raise InvalidInput(f"unknown command {command!r}; use one of {', '.join(REST_COMMANDS)}, stop",
+                               "unknown_command")
+        speed = number(body, "speed", low=0.0, high=1.0, default=config["ROVER_WEB_TELEOP_REST_DEFAULT_SPEED"])
+        max_s = config["ROVER_WEB_TELEOP_REST_MAX_DURATION_S"]
+        duration_s = number(body, "duration_s", low=0.0, high=max_s,
+                            default=config["ROVER_WEB_TELEOP_REST_DEFAULT_DURATION_S"])
+        if duration_s <= 0:
+            raise InvalidInput(f"'duration_s' must be greater than 0 and at most {max_s:g}", "out_of_range")
+    except InvalidInput as exc:
+        raise ApiError(400, exc.code, str(exc)) from None
+    try:
+        linear_mps, angular_rps = teleop.controller.rest_command(command, speed, duration_s)
+    except Refused as exc:
+        raise ApiError(exc.status, exc.code, exc.message) from None
+    return jsonify(command=command, speed=speed, duration_s=duration_s, linear_mps=linear_mps,
+                   angular_rps=angular_rps)
+
+
+@bp.get("/api/estop")
+def estop_state():
+    return jsonify(current_feature(TeleopService).controller.estop)
+
+
+@bp.post("/api/estop")
+def estop_set():
+    teleop = current_feature(TeleopService)
+    body = json_body()
+    default_by = request.remote_addr or "unknown"
+    if body.get("engaged") is True:  # engaging always works, whatever else the body says
+        by = body.get("by") if isinstance(body.get("by"), str) else None
+        return jsonify(teleop.set_estop(True, operator_name(by) or default_by))
+    try:
+        only_keys(body, {"engaged", "by"})
+        if "engaged" not in body:
+            raise InvalidInput("'engaged' is required: true engages the e-stop, false releases it", "missing_field")
+        if not isinstance(body["engaged"], bool):
+            raise InvalidInput("'engaged' must be true or false", "bad_type")
+        by = text(body, "by", max_len=NAME_MAX_LEN, default=None)
+    except InvalidInput as exc:
+        raise ApiError(400, exc.code, str(exc)) from None
+    return jsonify(teleop.set_estop(False, operator_name(by) or default_by))
