@@ -11,6 +11,7 @@ geometry, occupancy, msgs.
 from __future__ import annotations
 
 from rover_web.core.state import Rover
+from rover_web.estop import EStopService
 
 from . import msgs, routes
 from .service import STALE_CHECK_S, LiveMapService, load_files
@@ -21,7 +22,7 @@ def init_app(app, rover: Rover) -> None:
     files = load_files(config)
     runtime = rover.runtime
     goal_publisher = runtime.publisher(msgs.POSE_STAMPED, config["ROVER_WEB_GOAL_TOPIC"], "default")
-    service = LiveMapService(rover, files, goal_publisher)
+    service = LiveMapService(rover, files, goal_publisher, rover.feature(EStopService))
     rover.add_feature(service)
 
     rover.hub.register("pose", "goal", "plan", "live_map")

@@ -9,6 +9,7 @@ from typing import Any
 
 from rover_web.config import ConfigError
 from rover_web.core.state import Rover
+from rover_web.estop import EStopService
 
 from . import msgs
 from .geometry import MapGeometry, wrap_angle
@@ -49,8 +50,9 @@ def load_files(config: dict[str, Any]) -> dict[str, MapDefinition]:
 class LiveMapService:
     """The maps, the robot track and the goal publisher of one app."""
 
-    def __init__(self, rover: Rover, files: dict[str, MapDefinition], goal_publisher):
+    def __init__(self, rover: Rover, files: dict[str, MapDefinition], goal_publisher, estop: EStopService):
         self.rover = rover
+        self.estop = estop
         config = rover.config
         self.files = files
         self.live: MapDefinition | None = None  # replaced whole on each new grid, never mutated
@@ -157,6 +159,7 @@ class LiveMapService:
                              f"y {min(corners[0][1], corners[1][1]):g}..{max(corners[0][1], corners[1][1]):g} m")
         if self.rover.stopping.is_set():
             raise ShuttingDown("the server is shutting down; no goal was sent")
+        self.estop.check_motion()
         yaw = wrap_angle(yaw)
         with self._goal_lock:
             stamp = self.rover.runtime.now_msg()

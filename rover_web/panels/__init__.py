@@ -10,6 +10,7 @@ side and the command path), oplog (SQLite operator log), msgs (message fields), 
 from __future__ import annotations
 
 from rover_web.core.state import Rover
+from rover_web.estop import EStopService
 
 from . import routes, spec
 from .msgs import field_kind
@@ -21,8 +22,10 @@ def init_app(app, rover: Rover) -> None:
     config = rover.config
     specs = spec.load(config["ROVER_WEB_PANELS_FILE"], config["ROVER_WEB_STALE_AFTER_S"], field_kind)
     rover.hub.register("panel", "panel_log")
-    service = PanelService(specs, rover, OperatorLog(rover.db, config["ROVER_WEB_PANELS_LOG_KEEP"]))
+    estop = rover.feature(EStopService)
+    service = PanelService(specs, rover, OperatorLog(rover.db, config["ROVER_WEB_PANELS_LOG_KEEP"]), estop)
     rover.add_feature(service)
+    estop.on_engage(service.on_estop)
     app.register_blueprint(routes.bp)
     rover.add_panel(20, "panels/panels.html", "Control panels", channels=("panel",))
     rover.add_nav("Panels", "/panels")

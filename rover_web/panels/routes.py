@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from flask import Blueprint, abort, current_app, jsonify, render_template, request
 
+from rover_web.auth import signed_in_name
 from rover_web.core.state import current_feature
 from rover_web.web.http import ApiError, error_response, json_body
 
@@ -26,7 +27,8 @@ def service() -> PanelService:
 
 
 def _client() -> str:
-    return request.remote_addr or ""
+    """Who the operator log names: the signed-in user, else (sign-in off) the client's address."""
+    return signed_in_name() or request.remote_addr or ""
 
 
 def _page_panels(panel_ids: list[str]) -> list[dict]:

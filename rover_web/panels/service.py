@@ -15,6 +15,7 @@ import time
 from typing import Any
 
 from rover_web.core.state import Rover
+from rover_web.estop import EStopService
 from rover_web.web.validate import InvalidInput, only_keys
 
 from . import msgs
@@ -55,9 +56,10 @@ class CommandRefused(PanelError):
 
 
 class PanelService:
-    def __init__(self, specs: tuple[PanelSpec, ...], rover: Rover, oplog: OperatorLog):
+    def __init__(self, specs: tuple[PanelSpec, ...], rover: Rover, oplog: OperatorLog, estop: EStopService):
         self.rover = rover
         self.oplog = oplog
+        self.estop = estop
         self.specs = {s.id: s for s in specs}
         self.states = {s.id: PanelState(s) for s in specs}
         self._view_lock = threading.Lock()
@@ -179,6 +181,10 @@ class PanelService:
                 "confirmation_required"), client)
         with state.lock:
             self._expire(state)
+            if self.estop.engaged and not control.allowed_during_estop:
+                self._refuse(state, control, value, "refused", CommandRefused(
+                    f"the e-stop is engaged: {control.label} is not sent until it is released", "estop_engaged"),
+                    client)
             refusal = state.refusal(control)
             if refusal is not None:
                 self._refuse(state, control, value, "refused", CommandRefused(refusal.reason, refusal.code), client)
@@ -188,6 +194,18 @@ class PanelService:
         self.publish_view()
         return {"result": "sent", "panel": panel_id, "control": control.id, "topic": control.topic,
                 "type": control.type.name, "value": value, "log": entry}
+
+    def on_estop(self, by: str) -> None:
+        """The e-stop engaged: send each panel's `on_estop` button, whatever its lock and rules say."""
+        for state in self.states.values():
+            control = state.spec.control(state.spec.on_estop) if state.spec.on_estop else None
+            if control is None:
+                continue
+            with state.lock:
+                self._publishers[control.topic].publish(msgs.scalar_message(control.type.name, control.value))
+                self._record(state.spec.id, control.id, control.label, control.value, "sent",
+                             f"e-stop engaged by {by}", "e-stop")
+        self.publish_view()
 
     def _refuse(self, state: PanelState, control: ControlSpec, value: Any, result: str, error: PanelError,
                 client: str) -> None:

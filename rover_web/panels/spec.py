@@ -162,6 +162,7 @@ class ControlSpec:
     confirm: bool = False
     requires_unlock: bool = True
     style: str = ""
+    allowed_during_estop: bool = False  # may still be sent while the e-stop is engaged (a "stop" or "land")
 
 
 @dataclass(frozen=True)
@@ -182,6 +183,7 @@ class PanelSpec:
     light: LightSpec | None
     unlock_timeout_s: float
     stale_after_s: float
+    on_estop: str | None = None  # a button sent automatically when the e-stop engages (no unlock needed)
 
     def display(self, display_id: str) -> DisplaySpec | None:
         return next((d for d in self.displays if d.id == display_id), None)
@@ -244,7 +246,8 @@ def _panel(pid: str, table: Any, where: _Where, default_stale_s: float, field_ki
                           "(they appear in URLs)")
     if not isinstance(table, dict):
         raise where.error("must be a table of fields, e.g. [panels.drone]")
-    _only_keys(table, {"title", "unlock_timeout_s", "stale_after_s", "light", "displays", "controls"}, where, None)
+    _only_keys(table, {"title", "unlock_timeout_s", "stale_after_s", "light", "displays", "controls", "on_estop"},
+               where, None)
     title = _text(table, "title", where, default=pid.replace("_", " ").capitalize())
     unlock_timeout_s = _positive(table, "unlock_timeout_s", where, DEFAULT_UNLOCK_TIMEOUT_S)
     stale_after_s = _positive(table, "stale_after_s", where, default_stale_s)
@@ -262,7 +265,15 @@ def _panel(pid: str, table: Any, where: _Where, default_stale_s: float, field_ki
     light = None
     if "light" in table:
         light = _light(table["light"], where.at("light"), by_id)
-    return PanelSpec(pid, title, displays, controls, light, unlock_timeout_s, stale_after_s)
+    on_estop = None
+    if "on_estop" in table:
+        on_estop = _text(table, "on_estop", where)
+        control = next((c for c in controls if c.id == on_estop), None)
+        if control is None or control.kind != "button":
+            buttons = ", ".join(c.id for c in controls if c.kind == "button") or "none"
+            raise where.error(f"names {on_estop!r}, which is not a button of this panel (buttons: {buttons})",
+                              "on_estop")
+    return PanelSpec(pid, title, displays, controls, light, unlock_timeout_s, stale_after_s, on_estop)
 
 
 def _display(did: str, d: Any, where: _Where, field_kind: FieldKind | None) -> DisplaySpec:
@@ -303,7 +314,8 @@ def _control(cid: str, c: Any, where: _Where, displays: dict[str, DisplaySpec]) 
     kind = c.get("kind")
     if kind not in ("button", "input"):
         raise where.error(f"must be \"button\" or \"input\", got {_describe(kind)}", "kind")
-    common = {"kind", "label", "topic", "type", "enabled_when", "confirm", "requires_unlock", "style"}
+    common = {"kind", "label", "topic", "type", "enabled_when", "confirm", "requires_unlock", "style",
+              "allowed_during_estop"}
     extra = {"value"} if kind == "button" else {"min", "max", "max_length", "action"}
     _only_keys(c, common | extra, where, "a button" if kind == "button" else "an input")
     label = _text(c, "label", where)
@@ -345,11 +357,13 @@ def _control(cid: str, c: Any, where: _Where, displays: dict[str, DisplaySpec]) 
     enabled_when = _enabled_when(c.get("enabled_when", {}), where, displays)
     confirm = _bool(c, "confirm", where, False)
     requires_unlock = _bool(c, "requires_unlock", where, True)
+    allowed_during_estop = _bool(c, "allowed_during_estop", where, False)
     style = _text(c, "style", where, default="", allow_empty=True)
     if style not in STYLES:
         raise where.error(f"must be \"primary\", \"danger\" or empty, got {style!r}", "style")
     return ControlSpec(cid, kind, label, topic, stype, enabled_when=enabled_when, confirm=confirm,
-                       requires_unlock=requires_unlock, style=style, **fields)
+                       requires_unlock=requires_unlock, style=style, allowed_during_estop=allowed_during_estop,
+                       **fields)
 
 
 def _enabled_when(rules: Any, where: _Where, displays: dict[str, DisplaySpec]):

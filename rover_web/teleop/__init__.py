@@ -1,15 +1,15 @@
 """Teleop: the joystick WebSocket, REST drive commands, the e-stop, and the `teleop` SSE channel.
 
 Thin routes over TeleopController (control.py), which holds every rule (scaling, deadman,
-epochs, one operator at a time, e-stop latch). Velocity leaves the process only via rover.cmd_vel.
+epochs, one operator at a time, re-arming after an e-stop). Velocity leaves the process only via rover.cmd_vel.
 
   WS   /ws/teleop           joystick and keyboard frames (protocol.py, read by websocket.py)
   GET  /api/teleop          the controller's state (same as the `teleop` channel)
   POST /api/teleop          {"command": forward|back|left|right|stop, "speed": 0..1, "duration_s": ...}
-  GET  /api/estop           the e-stop latch
-  POST /api/estop           {"engaged": true|false, "by": "name"}
+The e-stop itself is its own feature (rover_web.estop); teleop refuses motion while it is engaged
+and re-arms each socket on release only after a neutral input.
 
-Modules: service (the per-app object), routes, control, protocol, websocket, ws_frames, estop_store.
+Modules: service (the per-app object), routes, control, protocol, websocket, ws_frames.
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ import logging
 from flask_sock import Sock
 
 from rover_web.core.state import Rover
+from rover_web.estop import EStopService
 
 from . import routes
 from .service import CHANNEL, CHANNEL_MAX_HZ, TeleopService
@@ -28,12 +29,13 @@ log = logging.getLogger(__name__)
 
 
 def init_app(app, rover: Rover) -> None:
-    teleop = TeleopService(rover)
+    teleop = TeleopService(rover, rover.feature(EStopService))
     rover.add_feature(teleop)
     # FrameReader: simple_websocket does the handshake, then our reader thread reads the frames
     # (websocket.py, ws_frames.py); TeleopSocket sends the pings.
     app.config["SOCK_SERVER_OPTIONS"] = {"ping_interval": None, "thread_class": FrameReader}
-    app.before_request(routes.offer_no_extensions)
+    app.before_request(routes.before_handshake)
+    app.teardown_request(routes.release_slot)
     sock = Sock(app)
     sock.route("/ws/teleop")(routes.teleop_socket)  # on the app: the blueprint is shared by every app
     app.register_blueprint(routes.bp)  # with the dashboard card's context (teleop_state)
@@ -44,6 +46,5 @@ def init_app(app, rover: Rover) -> None:
 
     if teleop.controller.estop["engaged"]:
         log.warning("the e-stop is engaged (since the last run); release it to drive")
-        rover.cmd_vel.zero()
     teleop.repeater.start()
     rover.on_shutdown(teleop.repeater.stop)

@@ -88,6 +88,9 @@ class Session:
     id: str
     name: str
     epoch: int = 0
+    # False from an e-stop release until this socket sends a neutral input: a stick or key held
+    # through the release must not move the robot the moment the latch opens.
+    armed: bool = True
     outbox: deque = field(default_factory=lambda: deque(maxlen=64))
     wake: Callable[[], None] | None = None
 
@@ -114,7 +117,8 @@ INPUT_REPEAT_DELAY = 1.2
 class TeleopController:
     def __init__(self, output, limits: Limits, *, rate_hz: float = 40.0, deadman_s: float = 0.3,
                  clock: Callable[[], float] = time.monotonic, wall_clock: Callable[[], float] = time.time,
-                 on_state: Callable[[dict], None] | None = None, estop: dict | None = None):
+                 on_state: Callable[[dict], None] | None = None, estop: dict | None = None,
+                 request_estop: Callable[[str], object] | None = None):
         self._cond = threading.Condition(threading.RLock())
         self._output = output
         self.limits = limits
@@ -124,6 +128,7 @@ class TeleopController:
         self._clock = clock
         self._wall = wall_clock
         self._on_state = on_state
+        self.request_estop = request_estop  # a socket's {"estop": true}: engages the app's e-stop
         self._sessions: dict[str, Session] = {}
         self._holder: Session | None = None
         self._command: Command | None = None
@@ -165,6 +170,8 @@ class TeleopController:
             self._require_open(session)
             if self._holder is session:
                 return
+            if self._estop["engaged"]:
+                raise Refused("estop_engaged", "the e-stop is engaged: nobody takes control until it is released")
             previous = self._holder
             self._holder = session
             if self._command is not None:
@@ -198,6 +205,11 @@ class TeleopController:
             if self._estop["engaged"]:
                 raise Refused("estop_engaged", "the e-stop is engaged: release it (POST /api/estop "
                               '{"engaged": false}) before driving')
+            if not session.armed:
+                if linear or angular:
+                    raise Refused("rearm_required", "the e-stop was released while this input was held: "
+                                  "release the stick (or key) to re-arm, then drive")
+                session.armed = True
             if epoch != session.epoch:
                 self.stats["stale_dropped"] += 1
                 raise Refused("stale_epoch", f"frame for epoch {epoch} dropped: the robot was stopped "
@@ -226,6 +238,7 @@ class TeleopController:
         """The holder's own stop (stick released, key up, tab hidden). A viewer's stop is ignored."""
         with self._cond:
             self._expire(self._clock())
+            session.armed = True  # a stop is the neutral input that re-arms after an e-stop
             if self._holder is not None and self._holder is not session:
                 return False
             self._stop(reason)
@@ -283,6 +296,7 @@ class TeleopController:
             if self._estop["engaged"]:
                 self._estop = {"engaged": False, "since": self._wall(), "by": by}
                 for session in self._sessions.values():
+                    session.armed = False
                     self._tell(session, "estop_released")
                 self._changed()
             return dict(self._estop)
@@ -369,7 +383,7 @@ class TeleopController:
         holder = self._holder
         return {"type": "state", "epoch": session.epoch, "in_control": holder is session,
                 "holder": holder.public() if holder else None, "estop": self._estop["engaged"],
-                "reason": reason}
+                "armed": session.armed, "reason": reason}
 
     def _publish(self, linear_mps: float, angular_rps: float) -> None:
         if self._closed:

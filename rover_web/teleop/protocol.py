@@ -5,6 +5,7 @@ Client -> server, one JSON object per text frame:
   {"stop": true}        the operator's own stop (stick released, key up, tab hidden)
   {"takeover": true}    take control from whoever holds it
   {"release": true}     give control back
+  {"estop": true}       engage the e-stop (any socket, driving or not): the page's fastest way to stop
 `epoch` (default 0) is the number from the server's latest "hello"/"state" message; `source`
 defaults to "joystick".
 
@@ -48,10 +49,10 @@ class Drive(NamedTuple):  # a tuple: built 40 times a second, and cheaper than a
 
 
 class Control(NamedTuple):
-    action: str  # stop | takeover | release
+    action: str  # stop | takeover | release | estop
 
 
-CONTROL_ACTIONS = ("stop", "takeover", "release")
+CONTROL_ACTIONS = ("stop", "takeover", "release", "estop")
 DRIVE_KEYS = {"linear", "angular", "epoch", "source"}
 
 

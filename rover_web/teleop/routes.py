@@ -1,29 +1,27 @@
 """Teleop's views: the joystick WebSocket, REST drive commands, the e-stop, and the dashboard card's context.
 
 The WebSocket view is routed on the app by flask_sock in init_app (the blueprint is shared by
-every app); `offer_no_extensions` runs before its handshake.
+every app); `before_handshake` runs before its handshake, `release_slot` after the socket ends.
 """
 
 from __future__ import annotations
 
 from flask import Blueprint, jsonify, request
 
+from rover_web.auth import signed_in_name
 from rover_web.core.state import current_feature, current_rover
-from rover_web.web.http import ApiError, error_response, json_body
+from rover_web.web.http import ApiError, json_body
+from rover_web.web.streams import stream_slot
 from rover_web.web.validate import InvalidInput, number, only_keys, text
 
 from .control import REST_COMMANDS, Refused
-from .service import EStopNotRecorded, TeleopService
+from .service import TeleopService
 from .websocket import TeleopSocket
 
 NAME_MAX_LEN = 40
+SLOT_KEY = "rover_web.stream_slot"
 
 bp = Blueprint("teleop", __name__)
-
-
-@bp.errorhandler(EStopNotRecorded)
-def estop_not_recorded(exc: EStopNotRecorded):
-    return error_response(503, "estop_not_recorded", str(exc))
 
 
 @bp.app_context_processor
@@ -44,7 +42,8 @@ def teleop_socket(ws) -> None:
     teleop = current_feature(TeleopService)
     controller = teleop.controller
     try:
-        session = controller.connect(operator_name(request.args.get("name")))
+        # Signed in, the session is the user's, whatever name the page asks for.
+        session = controller.connect(signed_in_name() or operator_name(request.args.get("name")))
         hello = {**controller.session_state(session, "connected"), "type": "hello", "session": session.id,
                  "name": session.name, **teleop.hello()}
         TeleopSocket(ws, controller, session, teleop.max_frame_bytes).serve(
@@ -53,12 +52,20 @@ def teleop_socket(ws) -> None:
         ws.thread.attach(None)  # a reader that never got a TeleopSocket ends rather than wait forever
 
 
-def offer_no_extensions() -> None:
-    """Before the handshake: agree to no extension. Teleop frames are ~50 bytes, so
-    permessage-deflate would save nothing and cost zlib work on every frame at both ends; our
-    reader (ws_frames.py) reads plain frames and refuses compressed ones (1002)."""
+def before_handshake() -> None:
+    """A slot under the stream cap (503 before any handshake beyond it), and no extension: teleop
+    frames are ~50 bytes, so permessage-deflate would save nothing and cost zlib work on every
+    frame at both ends; our reader (ws_frames.py) reads plain frames and refuses compressed ones."""
     if request.endpoint == "teleop_socket":
+        request.environ[SLOT_KEY] = stream_slot("teleop")
         request.environ.pop("HTTP_SEC_WEBSOCKET_EXTENSIONS", None)
+
+
+def release_slot(_exc=None) -> None:
+    """After the socket's request ends, however it ended (a failed handshake included)."""
+    slot = request.environ.pop(SLOT_KEY, None)
+    if slot is not None:
+        slot.release()
 
 
 # --- REST ---
@@ -99,28 +106,3 @@ def teleop_command():
         raise ApiError(exc.status, exc.code, exc.message) from None
     return jsonify(command=command, speed=speed, duration_s=duration_s, linear_mps=linear_mps,
                    angular_rps=angular_rps)
-
-
-@bp.get("/api/estop")
-def estop_state():
-    return jsonify(current_feature(TeleopService).controller.estop)
-
-
-@bp.post("/api/estop")
-def estop_set():
-    teleop = current_feature(TeleopService)
-    body = json_body()
-    default_by = request.remote_addr or "unknown"
-    if body.get("engaged") is True:  # engaging always works, whatever else the body says
-        by = body.get("by") if isinstance(body.get("by"), str) else None
-        return jsonify(teleop.set_estop(True, operator_name(by) or default_by))
-    try:
-        only_keys(body, {"engaged", "by"})
-        if "engaged" not in body:
-            raise InvalidInput("'engaged' is required: true engages the e-stop, false releases it", "missing_field")
-        if not isinstance(body["engaged"], bool):
-            raise InvalidInput("'engaged' must be true or false", "bad_type")
-        by = text(body, "by", max_len=NAME_MAX_LEN, default=None)
-    except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
-    return jsonify(teleop.set_estop(False, operator_name(by) or default_by))

@@ -96,6 +96,10 @@ def handle_frame(controller: TeleopController, session: Session, data, max_bytes
             controller.takeover(session)
         elif frame_.action == "release":
             controller.release(session)
+        elif frame_.action == "estop":
+            if controller.request_estop is None:
+                raise Refused("no_estop", "this server has no e-stop to engage", status=501)
+            controller.request_estop(session.name)  # the engage hook tells every socket, this one too
     except Refused as exc:
         return exc.as_frame()
     return None

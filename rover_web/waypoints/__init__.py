@@ -18,6 +18,7 @@ and imports change only the stored mission; the robot gets them with "send missi
 from __future__ import annotations
 
 from rover_web.core.state import Rover
+from rover_web.estop import EStopService
 
 from . import broadcaster, routes
 from .msgs import NAV_SAT_FIX, fix_reading
@@ -25,7 +26,7 @@ from .service import FIX_CHANNEL, WaypointsService
 
 
 def init_app(app, rover: Rover) -> None:
-    service = WaypointsService(rover)
+    service = WaypointsService(rover, rover.feature(EStopService))
     rover.add_feature(service)
     app.register_blueprint(routes.bp)
     rover.hub.register(broadcaster.CHANNEL, FIX_CHANNEL)

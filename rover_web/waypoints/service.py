@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import logging
+
 from rover_web.basemap.source import basemap
 from rover_web.core.state import Rover
+from rover_web.estop import EStopService
 
 from .broadcaster import MissionBroadcaster
 from .gps import FixReading, GpsTrack
@@ -14,13 +17,16 @@ FIX_CHANNEL = "fix"
 FIX_CHANNEL_MAX_HZ = 5.0
 # Every waypoint is a command the robot must not miss: keep enough history that a subscriber a
 # few hundred milliseconds behind a burst of clicks (or a script) still receives all of them.
+log = logging.getLogger(__name__)
+
 WAYPOINT_QOS_DEPTH = 1000
 
 
 class WaypointsService:
-    def __init__(self, rover: Rover):
+    def __init__(self, rover: Rover, estop: EStopService):
         config = rover.config
         self.config = config
+        self.estop = estop
         self.store = WaypointStore(rover.db, config["ROVER_WEB_MAX_WAYPOINTS"])
         runtime = rover.runtime
         self.waypoint_topic = config["ROVER_WEB_WAYPOINTS_TOPIC"]
@@ -38,6 +44,7 @@ class WaypointsService:
     # --- changes ---
 
     def add(self, lng: float, lat: float, label: str = "") -> Waypoint:
+        self.estop.check_motion()  # every add is published on /waypoints: a command to the robot
         # Published once committed, by the committer thread: /waypoints carries the waypoints in
         # the mission's order even when several browsers or scripts add at the same moment.
         waypoint, _revision = self.store.add(lng, lat, label, announce=self._announce)
@@ -45,6 +52,9 @@ class WaypointsService:
         return waypoint
 
     def _announce(self, waypoint: Waypoint) -> None:
+        if self.estop.engaged:  # engaged between the check and the commit: kept, not sent
+            log.warning("waypoint %d stored but not published: the e-stop engaged meanwhile", waypoint.id)
+            return
         self.waypoint_pub.publish(waypoint_message(waypoint.lng, waypoint.lat))
 
     def changed(self) -> None:
@@ -56,6 +66,7 @@ class WaypointsService:
             raise StaleRevision(mission.revision)
         if not mission.waypoints:
             raise EmptyMission()
+        self.estop.check_motion()
         self.mission_pub.publish(mission_message([(w.lng, w.lat) for w in mission.waypoints]))
         return {"sent": len(mission.waypoints), "topic": self.mission_topic, **mission.to_dict()}
 

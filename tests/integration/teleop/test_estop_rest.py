@@ -57,12 +57,18 @@ def test_estop_while_driving_stops_at_once_refuses_motion_and_releases(rig, sse_
     # stop always works.
     assert post(server, "/api/teleop", {"command": "stop"}).status_code == 200
 
-    # Released: drivable again, by a fresh input.
+    # Released: the stick alice still holds does not drive; a neutral input re-arms, then it does.
     released = post(server, "/api/estop", {"engaged": False})
     assert released.status_code == 200 and released.json()["engaged"] is False
     stream.wait_for("teleop", lambda s: not s["estop"]["engaged"])
-    alice.wait_for(lambda m: m["type"] == "state" and m["reason"] == "estop_released")
+    notice = alice.wait_for(lambda m: m["type"] == "state" and m["reason"] == "estop_released")
+    assert notice["armed"] is False
     peer.clear("/cmd_vel")
+    alice.drive(0.4, 0.0)
+    assert alice.wait_for(lambda m: m["type"] == "error" and m["error"] == "rearm_required")
+    time.sleep(0.3)
+    assert not [t for t in twists(peer) if t[1] != 0.0]
+    alice.send({"stop": True})
     alice.drive(0.4, 0.0)
     peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == 2.0, timeout=2.0)
     alice.close()

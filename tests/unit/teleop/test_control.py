@@ -197,7 +197,43 @@ def test_estop_latch(rig):
     run_until(ctl, clock, 102)
     assert all(lin == 0.0 and ang == 0.0 for t, lin, ang in out.sent if t > 100)
     ctl.release_estop("b")
+    ctl.stop(a)  # the stick released: re-armed
     assert ctl.drive(a, 1, 0, epoch=a.epoch) == (5.0, 0.0)
+
+
+def test_an_input_held_through_a_release_does_not_drive_until_released_and_pressed_again(rig):
+    ctl, clock, out, states = rig
+    a = ctl.connect("a")
+    ctl.drive(a, 1, 0)
+    ctl.engage_estop("b")
+    ctl.release_estop("b")
+    assert a.outbox[-1]["reason"] == "estop_released" and a.outbox[-1]["armed"] is False
+    published = len(out.sent)
+    for _ in range(3):  # the page keeps sending the held stick
+        with pytest.raises(Refused) as info:
+            ctl.drive(a, 1, 0, epoch=a.epoch)
+        assert info.value.code == "rearm_required" and "re-arm" in info.value.message
+    assert len(out.sent) == published  # nothing went out
+    ctl.drive(a, 0, 0, epoch=a.epoch)  # a neutral stick re-arms as well as a stop
+    assert ctl.drive(a, 0.5, 0, epoch=a.epoch) == (2.5, 0.0)
+
+
+def test_a_socket_that_connects_after_the_release_is_armed(rig):
+    ctl, clock, out, states = rig
+    ctl.engage_estop("b")
+    ctl.release_estop("b")
+    late = ctl.connect("late")
+    assert ctl.drive(late, 1, 0, epoch=late.epoch) == (5.0, 0.0)
+
+
+def test_nobody_takes_control_while_the_e_stop_is_engaged(rig):
+    ctl, clock, out, states = rig
+    a, b = ctl.connect("a"), ctl.connect("b")
+    ctl.drive(a, 1, 0)
+    ctl.engage_estop("x")
+    with pytest.raises(Refused) as info:
+        ctl.takeover(b)
+    assert info.value.code == "estop_engaged" and info.value.status == 409
 
 
 def test_estop_restored_engaged():
