@@ -38,7 +38,7 @@ def init_app(app: Flask, rover: Rover) -> None:
         EStopStore(rover.db),
         zero=rover.cmd_vel.zero,
         publish_flag=lambda engaged: flag.publish(msgs.flag(engaged)),
-        cancel_goals=canceller.cancel_all if canceller else None,
+        canceller=canceller,
         on_change=lambda state: rover.hub.publish(CHANNEL, state))
     rover.add_feature(estop)
     app.register_blueprint(routes.bp)

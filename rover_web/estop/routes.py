@@ -37,7 +37,8 @@ def estop_engaged(exc: EStopEngaged):
 
 @bp.get("/api/estop")
 def estop_state():
-    return jsonify(current_feature(EStopService).state())
+    estop = current_feature(EStopService)
+    return jsonify({**estop.state(), "cancellable_actions": estop.cancellable_actions()})
 
 
 @bp.post("/api/estop")

@@ -43,12 +43,12 @@ class ReleaseRefused(Exception):
 
 class EStopService:
     def __init__(self, store: EStopStore, *, zero: Callable[[], None], publish_flag: Callable[[bool], None],
-                 cancel_goals: Callable[[Callable[[list[dict]], None]], None] | None,
+                 canceller=None,
                  on_change: Callable[[dict], None], clock: Callable[[], float] = time.time):
         self._store = store
         self._zero = zero
         self._publish_flag = publish_flag
-        self._cancel_goals = cancel_goals
+        self._canceller = canceller  # has cancel_all(on_done) and running() (rover_web.ros.actions)
         self._on_change = on_change
         self._clock = clock
         loaded = store.load()
@@ -82,6 +82,10 @@ class EStopService:
         with self._lock:
             return dict(self._state)
 
+    def cancellable_actions(self) -> list[str]:
+        """Navigation actions with a server right now: an engage would cancel their goals."""
+        return self._canceller.running() if self._canceller is not None else []
+
     # --- engage and release ---
 
     def engage(self, by: str, via: str = "api") -> dict:
@@ -97,8 +101,8 @@ class EStopService:
         if not first:
             return self.state()
         log.warning("e-stop engaged by %s (%s)", by, via)
-        if self._cancel_goals is not None:
-            self._cancel_goals(self._goals_canceled)
+        if self._canceller is not None:
+            self._canceller.cancel_all(self._goals_canceled)
         persisted = self._persist(state)
         with self._lock:
             if self._state.get("since") == state["since"]:

@@ -25,6 +25,10 @@ class GoalCanceller:
     def actions(self) -> list[str]:
         return list(self._clients)
 
+    def running(self) -> list[str]:
+        """The actions whose server this node can reach now: the ones an engage would cancel."""
+        return [name for name, client in self._clients.items() if client.service_is_ready()]
+
     def cancel_all(self, on_done: Callable[[list[dict]], None], timeout_s: float = 1.0) -> None:
         """Ask every running action server to cancel all its goals, without waiting for the answers:
         `on_done` gets one outcome per action when all have answered or `timeout_s` has passed."""

@@ -49,9 +49,20 @@ def db(tmp_path):
     database.close()
 
 
-def make(db, robot, store=None, cancel=None):
+class Canceller:
+    def __init__(self):
+        self.asked = []
+
+    def cancel_all(self, on_done):
+        self.asked.append(on_done)
+
+    def running(self):
+        return ["/navigate_to_pose"]
+
+
+def make(db, robot, store=None, canceller=None):
     store = store or EStopStore(db)
-    return EStopService(store, zero=robot.zero, publish_flag=robot.flag, cancel_goals=cancel,
+    return EStopService(store, zero=robot.zero, publish_flag=robot.flag, canceller=canceller,
                         on_change=robot.changes.append)
 
 
@@ -180,10 +191,12 @@ def test_a_failing_hook_does_not_keep_the_others_or_the_flag_from_running(db):
 
 def test_goal_cancel_outcomes_join_the_state(db):
     robot = Robot()
-    asked = []
-    estop = make(db, robot, cancel=asked.append)
+    canceller = Canceller()
+    estop = make(db, robot, canceller=canceller)
+    assert estop.cancellable_actions() == ["/navigate_to_pose"]
     estop.engage("ada")
-    assert len(asked) == 1
-    asked[0]([{"action": "/navigate_to_pose", "result": "canceled", "goals": 1}])
+    estop.engage("ada")  # already engaged: not asked twice
+    assert len(canceller.asked) == 1
+    canceller.asked[0]([{"action": "/navigate_to_pose", "result": "canceled", "goals": 1}])
     assert estop.state()["cancel"] == [{"action": "/navigate_to_pose", "result": "canceled", "goals": 1}]
     assert robot.changes[-1]["cancel"][0]["result"] == "canceled"
