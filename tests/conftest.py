@@ -111,11 +111,13 @@ def live_server(live_server_factory):
 class ServerProcess:
     """`flask --app rover_web run --no-reload` in its own process, as an operator starts it."""
 
-    def __init__(self, port: int | None = None, env: dict | None = None, args: list[str] | None = None):
+    def __init__(self, port: int | None = None, env: dict | None = None, args: list[str] | None = None,
+                 scheme: str = "http", ca: str | None = None):
         from tests.support.rospeer import subprocess_env
 
         self.port = port or free_port()
-        self.url = f"http://127.0.0.1:{self.port}"
+        self.url = f"{scheme}://127.0.0.1:{self.port}"
+        self.verify = str(ca) if ca else True  # the CA an HTTPS server's certificate is checked against
         self.env = subprocess_env(**(env or {}))
         self.args = args
         self.proc = None
@@ -130,13 +132,14 @@ class ServerProcess:
                             "--host", "127.0.0.1", "--port", str(self.port)]
         log = tempfile.NamedTemporaryFile(prefix="rover_web-server-", suffix=".log", delete=False)
         self.log_path = log.name
-        self.proc = subprocess.Popen(cmd, cwd=ROOT, env=self.env, stdout=log, stderr=subprocess.STDOUT)
+        with log:  # the child has its own descriptor; ours is not needed past the start
+            self.proc = subprocess.Popen(cmd, cwd=ROOT, env=self.env, stdout=log, stderr=subprocess.STDOUT)
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             if self.proc.poll() is not None:
                 raise RuntimeError(f"server exited with {self.proc.returncode}:\n{self.log()}")
             try:
-                if requests.get(self.url + "/api/status", timeout=1).ok:
+                if requests.get(self.url + "/api/status", timeout=1, verify=self.verify).status_code in (200, 401):
                     return self
             except requests.RequestException:
                 time.sleep(0.1)
@@ -162,10 +165,10 @@ class ServerProcess:
 def server_process(tmp_path):
     started = []
 
-    def make(port=None, env=None, args=None):
+    def make(port=None, env=None, args=None, scheme="http", ca=None):
         env = dict(env or {})
         env.setdefault("ROVER_WEB_DB_PATH", str(tmp_path / f"server{len(started)}.sqlite3"))
-        server = ServerProcess(port, env, args)
+        server = ServerProcess(port, env, args, scheme, ca)
         started.append(server)
         return server
 

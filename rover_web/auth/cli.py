@@ -124,7 +124,7 @@ def tls_self_signed(hosts: tuple[str, ...], directory: Path | None) -> None:
     """Write a self-signed certificate and key into the instance folder."""
     directory = directory or Path(current_app.instance_path) / "tls"
     cert, key = write_self_signed(directory, list(hosts) or default_hosts())
-    click.echo(f"wrote {cert} and {key}")
+    click.echo(f"wrote {cert} and {key}; trust {directory / 'ca.pem'} on the devices that browse to it")
     click.echo(f"use them with:\n  export ROVER_WEB_TLS_CERT={cert} ROVER_WEB_TLS_KEY={key}")
 
 

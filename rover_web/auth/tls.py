@@ -1,8 +1,9 @@
-"""A self-signed certificate for HTTPS on a robot's own network (`flask tls self-signed`).
+"""Certificates for HTTPS on a robot's own network (`flask tls self-signed`).
 
 HTTPS is what lets a browser on another machine use the Gamepad API and keeps passwords and
-session cookies off the air. A self-signed certificate needs one "accept" per browser; a team with
-its own CA can use any certificate and key instead (ROVER_WEB_TLS_CERT, ROVER_WEB_TLS_KEY).
+session cookies off the air. The command makes a small local CA and a server certificate it signs
+(as mkcert does): trust ca.pem once on each operator's device, or accept the warning once per
+browser. A team with its own CA uses its own certificate and key (ROVER_WEB_TLS_CERT, _KEY).
 """
 
 from __future__ import annotations
@@ -35,26 +36,45 @@ def _san(hosts: list[str]) -> x509.SubjectAlternativeName:
     return x509.SubjectAlternativeName(names)
 
 
+def _name(common_name: str) -> x509.Name:
+    return x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, common_name[:64]),
+                      x509.NameAttribute(NameOID.ORGANIZATION_NAME, "rover_web (self-signed)")])
+
+
 def write_self_signed(directory: Path, hosts: list[str]) -> tuple[Path, Path]:
-    """Write cert.pem and key.pem (the key readable by its owner only); returns their paths."""
+    """Write ca.pem (a local CA to trust on each operator's device), cert.pem (the server's
+    certificate for `hosts`, signed by that CA) and key.pem (readable by its owner only).
+    Returns the certificate's and the key's paths: the pair ROVER_WEB_TLS_CERT/KEY name."""
     if not hosts:
         raise ValueError("name at least one host")
     directory.mkdir(parents=True, exist_ok=True)
-    key = ec.generate_private_key(ec.SECP256R1())
-    name = x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, hosts[0][:64]),
-                      x509.NameAttribute(NameOID.ORGANIZATION_NAME, "rover_web (self-signed)")])
     now = datetime.datetime.now(datetime.UTC)
+    valid = {"not_valid_before": now - datetime.timedelta(minutes=5),
+             "not_valid_after": now + datetime.timedelta(days=VALID_DAYS)}
+    # The CA's key signs once, here, and is not kept: nothing else can be issued in its name.
+    ca_key = ec.generate_private_key(ec.SECP256R1())
+    ca_name = _name(f"rover_web local CA {hosts[0]}")
+    ca = (x509.CertificateBuilder()
+          .subject_name(ca_name).issuer_name(ca_name)
+          .public_key(ca_key.public_key())
+          .serial_number(x509.random_serial_number())
+          .not_valid_before(valid["not_valid_before"]).not_valid_after(valid["not_valid_after"])
+          .add_extension(x509.BasicConstraints(ca=True, path_length=0), critical=True)
+          .add_extension(x509.KeyUsage(digital_signature=False, content_commitment=False, key_encipherment=False,
+                                       data_encipherment=False, key_agreement=False, key_cert_sign=True,
+                                       crl_sign=True, encipher_only=False, decipher_only=False), critical=True)
+          .sign(ca_key, hashes.SHA256()))
+    key = ec.generate_private_key(ec.SECP256R1())
     cert = (x509.CertificateBuilder()
-            .subject_name(name).issuer_name(name)
+            .subject_name(_name(hosts[0])).issuer_name(ca_name)
             .public_key(key.public_key())
             .serial_number(x509.random_serial_number())
-            .not_valid_before(now - datetime.timedelta(minutes=5))
-            .not_valid_after(now + datetime.timedelta(days=VALID_DAYS))
+            .not_valid_before(valid["not_valid_before"]).not_valid_after(valid["not_valid_after"])
             .add_extension(_san(hosts), critical=False)
             .add_extension(x509.BasicConstraints(ca=False, path_length=None), critical=True)
             .add_extension(x509.ExtendedKeyUsage([ExtendedKeyUsageOID.SERVER_AUTH]), critical=False)
-            .sign(key, hashes.SHA256()))
-    cert_path, key_path = directory / "cert.pem", directory / "key.pem"
+            .sign(ca_key, hashes.SHA256()))
+    ca_path, cert_path, key_path = directory / "ca.pem", directory / "cert.pem", directory / "key.pem"
     key_bytes = key.private_bytes(serialization.Encoding.PEM, serialization.PrivateFormat.PKCS8,
                                   serialization.NoEncryption())
     # Created with 0600 from the start: never world-readable, not even for an instant.
@@ -62,5 +82,6 @@ def write_self_signed(directory: Path, hosts: list[str]) -> tuple[Path, Path]:
     with os.fdopen(fd, "wb") as f:
         f.write(key_bytes)
     os.chmod(key_path, 0o600)
+    ca_path.write_bytes(ca.public_bytes(serialization.Encoding.PEM))
     cert_path.write_bytes(cert.public_bytes(serialization.Encoding.PEM))
     return cert_path, key_path

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import socket
+import ssl
 import time
 
 from flask import Blueprint, Response, request, stream_with_context
@@ -78,7 +79,10 @@ def events():
     keepalive_s = config["ROVER_WEB_SSE_KEEPALIVE_S"]
     sock = request.environ.get("werkzeug.socket") or request.environ.get("gunicorn.socket")
     retry = f"retry: {config['ROVER_WEB_SSE_RETRY_MS']}\n\n".encode()
-    if sock is not None and request.environ.get("SERVER_PROTOCOL", "").startswith("HTTP/1."):
+    # The Broadcaster writes plain TCP sockets itself, many per thread; a TLS stream is written by
+    # its own request thread through the TLS layer (the generator below).
+    if (sock is not None and not isinstance(sock, ssl.SSLSocket)
+            and request.environ.get("SERVER_PROTOCOL", "").startswith("HTTP/1.")):
         with slot:
             return _serve_on_socket(rover, sock, subscription, retry)
 

@@ -13,6 +13,8 @@ def test_self_signed_certificate(tmp_path):
     cert_path, key_path = write_self_signed(tmp_path / "tls", ["robot.local", "127.0.0.1"])
     context = ssl.SSLContext(ssl.PROTOCOL_TLS_SERVER)
     context.load_cert_chain(cert_path, key_path)
+    client = ssl.create_default_context(cafile=str(tmp_path / "tls" / "ca.pem"))  # trusting the local CA
+    assert client.cert_store_stats()["x509_ca"] == 1
     cert = x509.load_pem_x509_certificate(cert_path.read_bytes())
     san = cert.extensions.get_extension_for_class(x509.SubjectAlternativeName).value
     assert san.get_values_for_type(x509.DNSName) == ["robot.local"]
