@@ -1,0 +1,103 @@
+"""Every state-changing route, the teleop handshake and SSE, for each kind of caller.
+
+No credentials: 401. A viewer: 403, except engaging the e-stop. An operator: 2xx, except the
+admin routes (403), which an admin may use. The table must name every state-changing route the
+app has, so a new route cannot be added without deciding who may call it.
+"""
+
+import pytest
+import requests
+import websocket
+
+from tests.support.auth import add_users
+
+GEOJSON = {"type": "FeatureCollection", "features": [
+    {"type": "Feature", "geometry": {"type": "Point", "coordinates": [-71.0, 42.0]}, "properties": {}}]}
+
+# (method, path, body, the least role that may, the rule it exercises). Run in this order.
+REQUESTS = [
+    ("POST", "/api/estop", {"engaged": True}, "viewer", "/api/estop"),
+    ("POST", "/api/estop", {"engaged": False}, "operator", "/api/estop"),
+    ("POST", "/api/teleop", {"command": "stop"}, "operator", "/api/teleop"),
+    ("POST", "/api/maps/{map}/goal", {"x": 0.0, "y": 0.0}, "operator", "/api/maps/<name>/goal"),
+    ("POST", "/api/panels/drone/unlock", {}, "operator", "/api/panels/<panel_id>/unlock"),
+    ("POST", "/api/panels/drone/stop", {}, "operator", "/api/panels/<panel_id>/<control_id>"),
+    ("POST", "/api/panels/drone/lock", {}, "operator", "/api/panels/<panel_id>/lock"),
+    ("POST", "/waypoints", {"lng": -71.0, "lat": 42.0}, "operator", "/waypoints"),
+    ("POST", "/api/waypoints", {"lng": -71.001, "lat": 42.001}, "operator", "/api/waypoints"),
+    ("PATCH", "/api/waypoints/{waypoint}", {"label": "dock"}, "operator", "/api/waypoints/<int:waypoint_id>"),
+    ("POST", "/api/waypoints/send", {}, "operator", "/api/waypoints/send"),
+    ("DELETE", "/api/waypoints/{waypoint}", None, "operator", "/api/waypoints/<int:waypoint_id>"),
+    ("POST", "/api/waypoints/geojson", GEOJSON, "operator", "/api/waypoints/geojson"),
+    ("DELETE", "/api/waypoints", None, "operator", "/api/waypoints"),
+    ("POST", "/api/users", {"name": "new", "role": "viewer", "password": "long enough"}, "admin", "/api/users"),
+    ("PATCH", "/api/users/new", {"role": "operator"}, "admin", "/api/users/<name>"),
+    ("POST", "/api/tokens", {"user": "new"}, "admin", "/api/tokens"),
+    ("DELETE", "/api/tokens/{token}", None, "admin", "/api/tokens/<int:token_id>"),
+    ("DELETE", "/api/users/new", None, "admin", "/api/users/<name>"),
+    ("POST", "/logout", {}, "viewer", "/logout"),
+]
+RANK = {None: -1, "viewer": 0, "operator": 1, "admin": 2}
+PUBLIC = {("POST", "/login")}
+
+
+@pytest.fixture
+def signed_server(live_server_factory, tmp_path):
+    db_path = tmp_path / "roles.sqlite3"
+    tokens = add_users(db_path)
+    server = live_server_factory(ROVER_WEB_AUTH="required", ROVER_WEB_DB_PATH=str(db_path))
+    server.tokens = tokens
+    return server
+
+
+def test_the_table_names_every_state_changing_route(app):
+    changing = {(method, rule.rule) for rule in app.url_map.iter_rules()
+                for method in rule.methods & {"POST", "PUT", "PATCH", "DELETE"}}
+    covered = {(method, rule) for method, _path, _body, _role, rule in REQUESTS}
+    assert changing - PUBLIC == covered
+
+
+@pytest.mark.parametrize("caller", [None, "viewer", "operator", "admin"])
+def test_who_may_change_what(signed_server, caller):
+    headers = {"Authorization": f"Bearer {signed_server.tokens[caller]}"} if caller else {}
+    url = signed_server.url
+    admin = {"Authorization": f"Bearer {signed_server.tokens['admin']}"}
+    first_map = requests.get(url + "/api/maps", headers=admin, timeout=5).json()["maps"][0]["name"]
+    ids = {"map": first_map, "waypoint": 999, "token": 999}
+    for method, path, body, least, _rule in REQUESTS:
+        if "{waypoint}" in path and RANK[caller] >= RANK["operator"]:
+            mission = requests.get(url + "/api/waypoints", headers=admin, timeout=5).json()
+            ids["waypoint"] = mission["waypoints"][-1]["id"]
+        if "{token}" in path and RANK[caller] >= RANK["admin"]:
+            ids["token"] = requests.get(url + "/api/tokens", headers=admin, timeout=5).json()["tokens"][-1]["id"]
+        response = requests.request(method, url + path.format(**ids), json=body, headers=headers, timeout=10,
+                                    allow_redirects=False)
+        what = f"{caller} {method} {path}: {response.status_code} {response.text[:200]}"
+        if caller is None:
+            assert response.status_code == 401 and response.json()["error"] == "unauthenticated", what
+        elif RANK[caller] < RANK[least]:
+            assert response.status_code == 403 and response.json()["error"] == "forbidden", what
+        else:
+            assert 200 <= response.status_code < 300, what
+
+
+@pytest.mark.parametrize("caller,status", [(None, 401), ("viewer", 403), ("operator", 101)])
+def test_the_teleop_handshake(signed_server, caller, status):
+    header = [f"Authorization: Bearer {signed_server.tokens[caller]}"] if caller else []
+    ws_url = signed_server.url.replace("http://", "ws://") + "/ws/teleop"
+    if status == 101:
+        ws = websocket.create_connection(ws_url, header=header, timeout=5)
+        assert ws.getstatus() == 101
+        ws.close()
+        return
+    with pytest.raises(websocket.WebSocketBadStatusException) as refused:
+        websocket.create_connection(ws_url, header=header, timeout=5)
+    assert refused.value.status_code == status
+
+
+@pytest.mark.parametrize("caller,status", [(None, 401), ("viewer", 200), ("operator", 200)])
+def test_the_event_stream(signed_server, caller, status):
+    headers = {"Authorization": f"Bearer {signed_server.tokens[caller]}"} if caller else {}
+    with requests.get(signed_server.url + "/api/events?channels=status", headers=headers, stream=True,
+                      timeout=5) as response:
+        assert response.status_code == status
