@@ -17,7 +17,6 @@ import time
 
 import psutil
 import requests
-
 from common import ROOT, Server, machine, percentile, ros_env
 
 sys.path.insert(0, str(ROOT))
@@ -45,7 +44,7 @@ def run(server: Server, camera: psutil.Process, viewers: int, seconds: float, qu
     clients = [MjpegClient(url, keep_frames=False) for _ in range(viewers)]
     try:
         for client in clients:
-            wait_for(lambda: client.count >= 10, 20, "first frames")
+            wait_for(lambda client=client: client.count >= 10, 20, "first frames")
         time.sleep(1.0)  # settle
         counts0 = [c.count for c in clients]
         for c in clients:
@@ -61,7 +60,7 @@ def run(server: Server, camera: psutil.Process, viewers: int, seconds: float, qu
     finally:
         for client in clients:
             client.close()
-    fps = [(b - a) / (t1 - t0) for a, b in zip(counts0, counts1)]
+    fps = [(b - a) / (t1 - t0) for a, b in zip(counts0, counts1, strict=True)]
     dt = t1 - t0
     return {
         "viewers": viewers,
@@ -107,7 +106,8 @@ def bench(args, noise: float) -> None:
             latency = r["latency_ms"]
             print(f"viewers {n:3d}: fps/viewer median {r['fps_median']:5.1f} min {r['fps_min']:5.1f}  "
                   f"server CPU {r['cpu_pct']:5.1f}% of one core  "
-                  f"encode median {enc.get('median', float('nan')):5.2f} ms p99 {enc.get('p99', float('nan')):5.2f} ms  "
+                  f"encode median {enc.get('median', float('nan')):5.2f} ms "
+                  f"p99 {enc.get('p99', float('nan')):5.2f} ms  "
                   f"encodes {r['encodes_hz']:4.1f}/s of {r['received_hz']:4.1f} frames/s received  "
                   f"latency median {latency[0]:5.1f} ms p99 {latency[1]:5.1f} ms  "
                   f"JPEG {r['jpeg_kb']:.1f} kB  RSS {r['rss_mb']:.0f} MB  camera CPU {r['camera_cpu_pct']:.1f}%",

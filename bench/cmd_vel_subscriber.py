@@ -10,11 +10,11 @@ import sys
 import time
 
 import rclpy
-from rclpy.event_handler import SubscriptionEventCallbacks
-from rclpy.parameter import Parameter
 from geometry_msgs.msg import Twist
 from rclpy.context import Context
+from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 

@@ -46,7 +46,8 @@ class Server:
         self.url = f"http://127.0.0.1:{self.port}"
         # A throwaway database: a bench must never touch the operator's waypoints or e-stop latch.
         self._tmp = tempfile.TemporaryDirectory(prefix="rover_web-bench-")
-        env = {**env, "ROVER_WEB_DB_PATH": env.get("ROVER_WEB_DB_PATH") or os.path.join(self._tmp.name, "bench.sqlite3")}
+        env = {**env,
+               "ROVER_WEB_DB_PATH": env.get("ROVER_WEB_DB_PATH") or os.path.join(self._tmp.name, "bench.sqlite3")}
         if kind == "gunicorn":
             cmd = [sys.executable, "-m", "gunicorn", "-c", str(ROOT / "gunicorn.conf.py"),
                    "--bind", f"127.0.0.1:{self.port}", "rover_web:create_app()"]
@@ -175,7 +176,8 @@ def percentile(values: list[float], p: float) -> float:
 
 def summary_ms(latencies_s: list[float]) -> str:
     ms = [x * 1000 for x in latencies_s]
-    return f"median {statistics.median(ms):6.3f} ms  p99 {percentile(ms, 99):6.3f} ms  max {max(ms):6.3f} ms  n={len(ms)}"
+    return (f"median {statistics.median(ms):6.3f} ms  p99 {percentile(ms, 99):6.3f} ms  "
+            f"max {max(ms):6.3f} ms  n={len(ms)}")
 
 
 def machine() -> str:

@@ -253,17 +253,18 @@ def run(streams: Streams, publisher: Publisher, messages: int, interval_s: float
         waiting = [s.light_events_seen for s in streams.streams]
         t_pub = publisher.publish(text)
 
-        def frame(stream, mark):
+        def frame(stream, mark, text=text):
             return next(((w, a) for w, a, d in stream.frames[mark:] if d["light"] == text), None)
 
         while True:
-            streams.pump(lambda: all(s.light_events_seen > n for s, n in zip(streams.streams, waiting)), 10)
+            streams.pump(lambda waiting=waiting: all(
+                s.light_events_seen > n for s, n in zip(streams.streams, waiting, strict=True)), 10)
             streams.parse()
-            found = [frame(s, m) for s, m in zip(streams.streams, marks)]
+            found = [frame(s, m) for s, m in zip(streams.streams, marks, strict=True)]
             if all(found):
                 break
             # a frame cut in two, or another change first: wait for more on those streams only
-            waiting = [-1 if f else s.light_events_seen for s, f in zip(streams.streams, found)]
+            waiting = [-1 if f else s.light_events_seen for s, f in zip(streams.streams, found, strict=True)]
         out["arrived"] += [a - t_pub for _, a in found]
         out["woken"] += [w - t_pub for w, _ in found]
         out["last"].append(max(a for _, a in found) - t_pub)
@@ -319,7 +320,8 @@ def main() -> None:
               f"{'woken p50/p99':>15} {'server CPU %':>12} {'RSS MiB':>8}")
         for count in counts:
             streams = Streams(port, count)
-            streams.pump(lambda: all(s.light_events_seen for s in streams.streams), 10)  # every snapshot is in
+            streams.pump(lambda streams=streams: all(s.light_events_seen for s in streams.streams),
+                         10)  # every snapshot is in
             cpu_before, wall_before = server_ps.cpu_times(), time.monotonic()
             result = run(streams, publisher, args.messages, args.interval, index)
             index += args.messages

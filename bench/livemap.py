@@ -30,7 +30,6 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 import requests  # noqa: E402
-
 from common import Server  # noqa: E402  (bench/ is on sys.path when run as a script)
 
 MAP = "Science Hall Basement"

@@ -189,11 +189,12 @@ def bench_frames(server: Server, sub: Subscriber, baseline: Baseline | None, n: 
         frames = {i: encoded(frame(value(i, n), epoch=epoch)) for i in indices}
         mark = sub.mark()
         cpu0, t0 = server.cpu_seconds(), time.monotonic()
-        times = on_grid(len(indices), RATE_HZ, lambda k: ws.sock.sendall(frames[indices[k]]))
+        times = on_grid(len(indices), RATE_HZ,
+                        lambda k, frames=frames, indices=indices: ws.sock.sendall(frames[indices[k]]))
         cpu_s, run_s = cpu_s + server.cpu_seconds() - cpu0, run_s + time.monotonic() - t0
         time.sleep(0.2)
         ws.send(json.dumps({"stop": True}))  # the operator's stop: no deadman, so no new epoch
-        app += match_latencies(sub, mark, dict(zip(indices, times)), n, MAX_LINEAR)
+        app += match_latencies(sub, mark, dict(zip(indices, times, strict=True)), n, MAX_LINEAR)
         if baseline is not None:
             base += baseline.run(indices, n)
     said = ", ".join(f"{k} x{v}" for k, v in sorted(ws.heard.counts.items()))
@@ -236,7 +237,7 @@ def bench_rate(server: Server, sub: Subscriber, hold_s: float) -> None:
     # From the first repeat on: the input itself goes out at once, and the first repeat after it
     # comes 1.2 periods later by design (teleop_control.INPUT_REPEAT_DELAY).
     times = [t for t, lin, _ in sub.since(mark)[: end - mark] if lin == 2.5][1:]
-    gaps = [b - a for a, b in zip(times, times[1:])]
+    gaps = [b - a for a, b in zip(times, times[1:], strict=False)]
     period = 1.0 / RATE_HZ
     dev_ms = [abs(g - period) * 1000 for g in gaps]
     rate = (len(times) - 1) / (times[-1] - times[0])
@@ -283,7 +284,7 @@ class Baseline:
 
         times = on_grid(len(indices), RATE_HZ, send)
         time.sleep(0.2)
-        return match_latencies(self.sub, mark, dict(zip(indices, times)), n, MAX_LINEAR)
+        return match_latencies(self.sub, mark, dict(zip(indices, times, strict=True)), n, MAX_LINEAR)
 
     def close(self) -> None:
         self.sub.stop()

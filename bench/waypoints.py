@@ -28,7 +28,6 @@ from pathlib import Path
 
 import psutil
 import requests
-
 from common import ROOT, Server, machine, percentile, ros_env
 
 sys.path.insert(0, str(ROOT))

@@ -243,7 +243,8 @@ class WaypointStore:
 
     @staticmethod
     def _bump(conn) -> int:
-        return conn.execute("UPDATE waypoints_meta SET revision = revision + 1 WHERE id = 1 RETURNING revision").fetchone()[0]
+        return conn.execute(
+            "UPDATE waypoints_meta SET revision = revision + 1 WHERE id = 1 RETURNING revision").fetchone()[0]
 
     @staticmethod
     def _check_revision(conn, expected: int) -> None:

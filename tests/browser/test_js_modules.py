@@ -7,7 +7,7 @@ from urllib.parse import quote
 import pytest
 import requests
 
-from rover_web.map_geometry import MapGeometry
+from rover_web.livemap.geometry import MapGeometry
 
 pytestmark = pytest.mark.browser
 
@@ -68,7 +68,7 @@ def test_livemap_geometry_matches_the_server_with_a_turned_origin(blank):
             return { pixel: [px, py], back: m.pixelToWorld(g, px, py), inside: m.insideMap(g, x, y) };
         });
     }""", [g, points])
-    for (x, y), js in zip(points, got):
+    for (x, y), js in zip(points, got, strict=True):
         assert js["pixel"] == pytest.approx(geo.world_to_pixel(x, y), abs=1e-9)
         assert js["back"] == pytest.approx((x, y), abs=1e-9)
         assert js["inside"] == geo.contains(x, y)
@@ -96,7 +96,8 @@ def test_view_zoom_keeps_the_floor_under_the_cursor_and_resize_keeps_the_middle(
         const resized = v.resizeView(fit, size, { width: 1200, height: 500 });
         return { fit, zoomed, before: g.screenToPixel(fit, 300, 200), after: g.screenToPixel(zoomed, 300, 200),
                  middleBefore: g.screenToPixel(fit, 500, 300), middleAfter: g.screenToPixel(resized, 600, 250),
-                 tooFar: v.zoomView(geo, size, fit, 1e-6, 0, 0).scale, tooClose: v.zoomView(geo, size, fit, 1e6, 0, 0).scale };
+                 tooFar: v.zoomView(geo, size, fit, 1e-6, 0, 0).scale,
+                 tooClose: v.zoomView(geo, size, fit, 1e6, 0, 0).scale };
     }""")
     assert got["fit"]["scale"] == pytest.approx(0.96 * min(1000 / 800, 600 / 480))
     assert got["zoomed"]["scale"] == pytest.approx(got["fit"]["scale"] * 1.25)

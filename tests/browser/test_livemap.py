@@ -57,7 +57,8 @@ def canvas_rgb(page, x, y):
     return tuple(page.evaluate("""([x, y]) => {
         const c = document.getElementById('livemap-canvas');
         const dpr = window.devicePixelRatio || 1;
-        return Array.from(c.getContext('2d').getImageData(Math.round(x * dpr), Math.round(y * dpr), 1, 1).data.slice(0, 3));
+        return Array.from(c.getContext('2d').getImageData(Math.round(x * dpr), Math.round(y * dpr), 1, 1)
+            .data.slice(0, 3));
     }""", [x, y]))
 
 
@@ -265,7 +266,8 @@ def test_zoom_with_buttons_wheel_and_pinch_and_pan_by_dragging(live_server, brow
         cx, cy = left + 500, top + 300
 
         def touch(kind, spread):
-            points = [] if kind == "touchEnd" else [{"x": cx - spread, "y": cy, "id": 0}, {"x": cx + spread, "y": cy, "id": 1}]
+            points = [] if kind == "touchEnd" else [{"x": cx - spread, "y": cy, "id": 0},
+                                                    {"x": cx + spread, "y": cy, "id": 1}]
             cdp.send("Input.dispatchTouchEvent", {"type": kind, "touchPoints": points})
 
         anchor = state(page)

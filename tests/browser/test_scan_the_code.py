@@ -42,7 +42,7 @@ def test_boxes_fill_in_order_and_reset_on_black(live_server, ros_peer, page):
              ("black", ["black", "black", "black"])]
     for text, expected in steps:
         peer.publish(LIGHTS, {"data": text})
-        for box, colour in zip(range(3), expected):
+        for box, colour in zip(range(3), expected, strict=True):
             expect(boxes.nth(box)).to_have_attribute("data-colour", colour)
             expect(boxes.nth(box).locator(".stc-box-name")).to_have_text(colour)
         expect(page.locator("#stc-lamp")).to_have_attribute("data-colour", text.lower())

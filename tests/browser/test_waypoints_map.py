@@ -4,15 +4,14 @@ the offline basemap; nothing ever leaves 127.0.0.1 and the console stays free of
 import io
 import subprocess
 import sys
-from pathlib import Path
 import time
 
 import numpy as np
 import pytest
 
+from rover_web.config import ROOT
 from tests.support.rospeer import subprocess_env
 from tests.support.waypoint_helpers import FLOAT64_MULTI_ARRAY, TileServer, stored_rows, warm_up_topic
-from rover_web.config import ROOT
 
 pytestmark = pytest.mark.browser
 

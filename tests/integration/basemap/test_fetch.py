@@ -6,14 +6,13 @@ import re
 import sqlite3
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
 from rover_web.basemap.tile_store import tile_count
+from rover_web.config import ROOT
 from tests.support.rospeer import subprocess_env
 from tests.support.waypoint_helpers import TileServer
-from rover_web.config import ROOT
 
 BBOX = "-82.462,27.366,-82.438,27.382"  # Nathan Benderson Park
 BBOX_TUPLE = (-82.462, 27.366, -82.438, 27.382)
@@ -102,8 +101,8 @@ def test_fetch_refuses_too_large_an_area_before_downloading(tile_server, no_ros_
     assert run.returncode != 0
     assert "the limit is 1,000" in run.stderr and "smaller --bbox" in run.stderr
     assert tile_server.requests == [] and not out.exists()
-    bad = flask_cli(no_ros_env, "tiles", "fetch", "--bbox", "-82,27,-83,28", "--zoom", "12", "--url", tile_server.template,
-                    "--out", str(out))
+    bad = flask_cli(no_ros_env, "tiles", "fetch", "--bbox", "-82,27,-83,28", "--zoom", "12",
+                    "--url", tile_server.template, "--out", str(out))
     assert bad.returncode == 2 and "W < E" in bad.stderr
 
 

@@ -100,7 +100,7 @@ def test_snapshot_returns_the_frame_published_by_another_process(live_server, ro
         assert response.headers["X-Timestamp"] == "42.500000000"
         picture = Image.open(io.BytesIO(response.content)).convert("RGB")
         assert picture.size == (16, 12)
-        assert all(abs(a - b) <= 14 for a, b in zip(picture.getpixel((8, 6)), (200, 30, 60)))
+        assert all(abs(a - b) <= 14 for a, b in zip(picture.getpixel((8, 6)), (200, 30, 60), strict=True))
         scaled = requests.get(live_server.url + "/snapshot", params={"topic": topic, "width": 8}, timeout=10)
         assert Image.open(io.BytesIO(scaled.content)).size == (8, 6)
     finally:
@@ -229,7 +229,8 @@ def test_compressed_jpeg_is_passed_through_and_png_is_converted(live_server, ros
                                  timeout=10)
         picture = Image.open(io.BytesIO(converted.content))
         assert picture.format == "JPEG" and picture.size == (24, 16)
-        assert all(abs(a - b) <= 14 for a, b in zip(picture.convert("RGB").getpixel((12, 8)), (200, 30, 60)))
+        assert all(abs(a - b) <= 14 for a, b in zip(picture.convert("RGB").getpixel((12, 8)), (200, 30, 60),
+                                                   strict=True))
         passthroughs = [s["passthroughs"] for s in streams(live_server).describe()
                         if s["topic"] == "/test_cam/jpeg/compressed"]
         assert passthroughs and passthroughs[0] >= 1

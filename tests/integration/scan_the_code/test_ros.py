@@ -172,7 +172,7 @@ def test_each_change_is_pushed_and_a_separate_subscriber_gets_the_confirmed_code
 
     expected_boxes = [["red", "black", "black"], ["red", "green", "black"], ["red", "green", "blue"],
                       ["black", "black", "black"]]
-    for text, boxes in zip(["red", "green", "blue", "black"], expected_boxes):
+    for text, boxes in zip(["red", "green", "blue", "black"], expected_boxes, strict=True):
         send(text, text)  # the second is the same light still on
         stream.wait_for("light_sequence", lambda s, b=boxes, t=text: s["boxes"] == b and s["light"] == t)
     first = wait_state(server, lambda s: s["code"] is not None)

@@ -60,7 +60,7 @@ def test_frames_at_40_hz_are_scaled_clamped_and_the_rate_holds(rig):
     peer.wait_for("/cmd_vel", is_zero, timeout=2.0)
     held = [t for t, lin, ang in twists(peer) if (round(lin, 9), round(ang, 9)) == (0.6, -0.4)]
     rate_hz = (len(held) - 1) / (held[-1] - held[0])
-    gaps = [b - a for a, b in zip(held, held[1:])]
+    gaps = [b - a for a, b in zip(held, held[1:], strict=False)]
     assert 36 <= rate_hz <= 44, rate_hz
     assert max(gaps) < 0.15, max(gaps)  # never near the robot's own command timeout
 
@@ -128,7 +128,7 @@ def test_bad_frames_get_error_frames_and_leave_the_robot_at_zero(rig):
         peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == 2.5, timeout=2.0)
         t_sent = time.monotonic()
         client.send(bad)
-        error = client.wait_for(lambda m: m["type"] == "error" and m["t"] > t_sent)
+        error = client.wait_for(lambda m, t_sent=t_sent: m["type"] == "error" and m["t"] > t_sent)
         assert error["status"] == 400 and error["message"]
         peer.wait_for("/cmd_vel", is_zero, timeout=1.0)
         time.sleep(0.35)  # past the deadman: nothing moves again by itself

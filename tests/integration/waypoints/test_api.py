@@ -162,9 +162,11 @@ def test_the_configured_maximum_is_409_and_stores_nothing_more(api, wp_app):
 
 
 @pytest.mark.parametrize("body, fragment", [
-    ({"type": "FeatureCollection", "features": [{"type": "Feature", "geometry": {"type": "Point", "coordinates": [1, 95]}}]},
+    ({"type": "FeatureCollection",
+      "features": [{"type": "Feature", "geometry": {"type": "Point", "coordinates": [1, 95]}}]},
      "features[0].geometry.coordinates[1] (lat)"),
-    ({"type": "FeatureCollection", "features": [{"type": "Feature", "geometry": {"type": "Polygon", "coordinates": []}}]},
+    ({"type": "FeatureCollection",
+      "features": [{"type": "Feature", "geometry": {"type": "Polygon", "coordinates": []}}]},
      "must be a Point"),
     ({"type": "Topology"}, "FeatureCollection"),
     ({"type": "FeatureCollection", "features": "all of them"}, "'features'"),

@@ -37,12 +37,14 @@ EDIT = st.fixed_dictionaries({}, optional={"lng": LNG, "lat": LAT, "label": LABE
 FEATURE = st.fixed_dictionaries({
     "type": st.sampled_from(["Feature"] * 6 + ["Point", "feature"]),
     "geometry": st.fixed_dictionaries({"type": st.sampled_from(["Point"] * 6 + ["LineString"]),
-                                       "coordinates": st.tuples(LNG, LAT).map(list) | st.lists(COORD, max_size=4)}) | JSON,
+                                       "coordinates": st.tuples(LNG, LAT).map(list) | st.lists(COORD, max_size=4)})
+                | JSON,
 }, optional={"properties": st.dictionaries(st.sampled_from(["label", "name", "x"]), LABEL, max_size=2) | JSON})
 GEOJSON = st.fixed_dictionaries({"type": st.sampled_from(["FeatureCollection"] * 4 + ["Feature"]),
                                  "features": st.lists(FEATURE, max_size=MAX_WAYPOINTS + 2) | JSON})
-RAW = st.binary(max_size=200) | st.sampled_from([b"", b"{", b"NaN", b'{"lng": NaN, "lat": 1}', b'{"lng": 1, "lat": Infinity}',
-                                                  b'{"lng": 1e999, "lat": 1}', b"[" * 5000, b'"\\ud800"',
+RAW = st.binary(max_size=200) | st.sampled_from([b"", b"{", b"NaN", b'{"lng": NaN, "lat": 1}',
+                                                  b'{"lng": 1, "lat": Infinity}', b'{"lng": 1e999, "lat": 1}',
+                                                  b"[" * 5000, b'"\\ud800"',
                                                   b'{"lng": 1, "lat": 1, "label": "\\ud800"}'])
 
 
@@ -130,7 +132,8 @@ class Harness:
             assert got == expected, f"{topic}: {len(got)} messages heard, {len(expected)} acknowledged"
             for data in got:
                 assert all(math.isfinite(v) for v in data)
-                assert all(-180 <= lng <= 180 and -90 <= lat <= 90 for lng, lat in zip(data[::2], data[1::2]))
+                assert all(-180 <= lng <= 180 and -90 <= lat <= 90
+                           for lng, lat in zip(data[::2], data[1::2], strict=True))
 
     def close(self):
         self.peer.close()
@@ -236,7 +239,8 @@ def test_fuzz_importing_geojson(fresh):
 def test_fuzz_reading_routes(fresh):
     @FUZZ
     @given(path=st.sampled_from(["/api/waypoints", "/api/waypoints/geojson", "/waypoints", "/tiles"])
-           .flatmap(lambda p: st.just(p) | st.text(alphabet="0123456789/-.?=&abcxyz%", max_size=30).map(lambda s: p + s)))
+           .flatmap(lambda p: st.just(p)
+                    | st.text(alphabet="0123456789/-.?=&abcxyz%", max_size=30).map(lambda s: p + s)))
     def run(path):
         fresh.request("GET", path)
 

@@ -20,7 +20,8 @@ def test_the_seed_curl_call_publishes_lng_first(server_process, ros_peer):
     peer.wait_match("/waypoints")
     warm_up_topic(server.url, peer)
     # Exactly the seeds' command line, with only the port changed.
-    out = subprocess.run(["curl", "-sS", "-X", "POST", f"{server.url}/waypoints", "-H", "Content-Type: application/json",
+    out = subprocess.run(["curl", "-sS", "-X", "POST", f"{server.url}/waypoints",
+                          "-H", "Content-Type: application/json",
                           "-d", '{"lng": 1.0, "lat": 2.0}', "-w", "\n%{http_code}"],
                          capture_output=True, text=True, timeout=30, check=True).stdout
     body, status = out.rsplit("\n", 1)

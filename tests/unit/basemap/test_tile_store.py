@@ -60,7 +60,8 @@ def test_mbtiles_written_by_another_tool_is_read_with_y_flipped(tmp_path):
     path = tmp_path / "area.mbtiles"
     conn = sqlite3.connect(path)
     conn.executescript("CREATE TABLE metadata (name text, value text);"
-                       "CREATE TABLE tiles (zoom_level integer, tile_column integer, tile_row integer, tile_data blob);")
+                       "CREATE TABLE tiles (zoom_level integer, tile_column integer, "
+                       "tile_row integer, tile_data blob);")
     # XYZ tile z=2, x=1, y=0 (the northern row) is TMS row 3.
     conn.execute("INSERT INTO tiles VALUES (2, 1, 3, ?)", (PNG,))
     conn.executemany("INSERT INTO metadata VALUES (?, ?)", [("bounds", "-10,-5,10,5"), ("attribution", "© them")])

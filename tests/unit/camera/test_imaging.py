@@ -27,7 +27,7 @@ def decode(jpeg: bytes) -> Image.Image:
 
 
 def close_to(pixel, expected, tolerance=14):
-    return all(abs(int(a) - int(b)) <= tolerance for a, b in zip(pixel, expected))
+    return all(abs(int(a) - int(b)) <= tolerance for a, b in zip(pixel, expected, strict=True))
 
 
 def two_halves(channels_for_colour, bpp, pad=5):

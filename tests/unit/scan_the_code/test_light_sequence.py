@@ -372,7 +372,7 @@ def test_clean_cycles_of_any_length_give_exactly_their_codes(cycles):
     feed = Feed()
     feed.light(BLACK, 1)
     for code, repeats in cycles:
-        for colour, n in zip(code + [BLACK], repeats):
+        for colour, n in zip(code + [BLACK], repeats, strict=True):
             feed.light(colour, n)
     assert feed.confirmed == [",".join(code) for code, _ in cycles]
     last = cycles[-1][0]

@@ -76,7 +76,7 @@ def test_new_input_is_published_at_once_and_repeated_on_a_fixed_grid(rig):
         ctl.drive(s, 0.5, 0.5)
     run_until(ctl, clock, 100.701)
     times = [t for t, lin, _ in out.sent if lin == 2.5]
-    gaps = [b - a for a, b in zip(times, times[1:])]
+    gaps = [b - a for a, b in zip(times, times[1:], strict=False)]
     assert gaps[0] == pytest.approx(0.025 * INPUT_REPEAT_DELAY)  # the first repeat after the input
     assert all(abs(g - 0.025) < 1e-9 for g in gaps[1:]), gaps
     assert len(times) == 28  # the input, then 40 Hz from 30 ms after it
@@ -184,7 +184,7 @@ def test_release_frees_control_and_stops(rig):
 
 def test_estop_latch(rig):
     ctl, clock, out, states = rig
-    a, b = ctl.connect("a"), ctl.connect("b")
+    a, _b = ctl.connect("a"), ctl.connect("b")
     ctl.drive(a, 1, 0)
     ctl.engage_estop("b")  # from a viewer: works whoever holds control
     assert out.last == (0.0, 0.0)

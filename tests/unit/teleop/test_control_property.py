@@ -35,7 +35,8 @@ def to_text(obj) -> str:
 frames = st.one_of(
     st.fixed_dictionaries({"linear": values, "angular": values}).map(to_text),
     st.fixed_dictionaries({"linear": numbers, "angular": numbers},
-                          optional={"epoch": st.integers(0, 3), "source": st.sampled_from(["joystick", "keyboard", "x"])}
+                          optional={"epoch": st.integers(0, 3),
+                                    "source": st.sampled_from(["joystick", "keyboard", "x"])}
                           ).map(to_text),
     st.dictionaries(st.sampled_from(["linear", "angular", "stop", "epoch", "z"]), values, max_size=4).map(to_text),
     st.text(max_size=40),

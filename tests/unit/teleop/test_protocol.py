@@ -81,7 +81,8 @@ def test_limit_is_inclusive():
 
 json_numbers = st.one_of(
     st.floats(allow_nan=False, allow_infinity=False), st.floats(min_value=-1.0, max_value=1.0),
-    st.integers(), st.integers(min_value=-10 ** 400, max_value=10 ** 400), st.sampled_from([2 ** 63, 2 ** 64, -2 ** 63 - 1]))
+    st.integers(), st.integers(min_value=-10 ** 400, max_value=10 ** 400),
+    st.sampled_from([2 ** 63, 2 ** 64, -2 ** 63 - 1]))
 json_values = st.recursive(
     st.one_of(json_numbers, st.booleans(), st.none(), st.text(max_size=8)),
     lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=6), inner, max_size=3), max_leaves=8)
@@ -89,7 +90,8 @@ frame_keys = st.sampled_from(["linear", "angular", "epoch", "source", "stop", "t
 frame_texts = st.one_of(
     st.dictionaries(frame_keys, json_values, max_size=5).map(json.dumps),
     st.fixed_dictionaries({"linear": json_numbers, "angular": json_numbers},
-                          optional={"epoch": json_numbers, "source": st.sampled_from(["joystick", "keyboard", "\ud800"])}
+                          optional={"epoch": json_numbers,
+                                    "source": st.sampled_from(["joystick", "keyboard", "\ud800"])}
                           ).map(json.dumps),
     json_values.map(json.dumps),
     st.tuples(st.sampled_from(['{"linear": %s, "angular": 0}', '{"epoch": %s, "linear": 0, "angular": 0}', '[%s]']),

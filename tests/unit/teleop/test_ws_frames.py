@@ -9,8 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from wsproto import ConnectionType, WSConnection
-from wsproto.events import (AcceptConnection, BytesMessage, CloseConnection, Message, Ping, Pong, Request,
-                            TextMessage)
+from wsproto.events import AcceptConnection, BytesMessage, CloseConnection, Message, Ping, Pong, Request, TextMessage
 
 from rover_web.teleop.ws_frames import (
     CLOSE_INVALID_PAYLOAD,
@@ -76,14 +75,14 @@ def our_events(chunks: list[bytes], max_bytes: int = BIG) -> list:
 
 def split(data: bytes, cuts: list[int]) -> list[bytes]:
     points = sorted({c % (len(data) + 1) for c in cuts})
-    return [data[a:b] for a, b in zip([0] + points, points + [len(data)])]
+    return [data[a:b] for a, b in zip([0] + points, points + [len(data)], strict=True)]
 
 
 def same_outcome(ours: list, theirs: list) -> None:
     """Equal events; a failure must carry the same code (the messages are each side's own words)."""
     strip = [(kind, body[0]) if kind == "close" else (kind, body) for kind, body in ours]
     assert strip == [(kind, body[0]) if kind == "close" else (kind, body) for kind, body in theirs]
-    for (kind, body), (_, their_body) in zip(ours, theirs):
+    for (kind, body), (_, their_body) in zip(ours, theirs, strict=True):
         if kind == "close" and body[0] not in (CLOSE_PROTOCOL_ERROR, CLOSE_INVALID_PAYLOAD):
             assert body == their_body  # a peer's own close: the reason too
 
@@ -134,7 +133,8 @@ def test_any_valid_stream_split_anywhere_reads_as_wsproto_reads_it(script, close
     chunks = split(stream, cuts)
     ours, theirs = our_events(chunks), wsproto_events(server, chunks)
     same_outcome(ours, theirs)
-    assert len([e for e in ours if e[0] in ("text", "binary")]) == len([a for a in script if a[0] in ("text", "binary")])
+    assert (len([e for e in ours if e[0] in ("text", "binary")])
+            == len([a for a in script if a[0] in ("text", "binary")]))
 
 
 # --- broken streams ---

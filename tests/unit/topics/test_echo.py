@@ -79,9 +79,9 @@ def test_long_strings_are_cut_with_their_length():
 
 
 def test_message_to_dict_cuts_big_arrays_fast_and_shows_lengths():
+    from nav_msgs.msg import Odometry
     from sensor_msgs.msg import Image
     from std_msgs.msg import ByteMultiArray
-    from nav_msgs.msg import Odometry
 
     from rover_web.ros.convert import message_to_dict
 

@@ -5,8 +5,8 @@ import json
 import pytest
 
 from rover_web.waypoints.geojson import mission_to_geojson, waypoints_from_geojson
-from rover_web.web.validate import InvalidInput
 from rover_web.waypoints.store import Mission, Waypoint
+from rover_web.web.validate import InvalidInput
 
 
 def mission(*points):
@@ -30,7 +30,8 @@ def test_round_trip_through_json_text_keeps_everything():
 def test_import_is_lenient_where_it_is_harmless():
     doc = {"type": "FeatureCollection", "features": [
         {"type": "Feature", "geometry": {"type": "Point", "coordinates": [1, 2, 30.5]}, "properties": None},
-        {"type": "Feature", "geometry": {"type": "Point", "coordinates": [3.5, 4]}, "properties": {"name": "from gpx", "ele": 3}},
+        {"type": "Feature", "geometry": {"type": "Point", "coordinates": [3.5, 4]},
+         "properties": {"name": "from gpx", "ele": 3}},
         {"type": "Feature", "id": "x", "geometry": {"type": "Point", "coordinates": [5, 6]}}],
         "crs": "ignored"}
     assert waypoints_from_geojson(doc, 10) == [(1.0, 2.0, ""), (3.5, 4.0, "from gpx"), (5.0, 6.0, "")]
@@ -47,7 +48,9 @@ def feature(coordinates, **extra):
     ({"type": "FeatureCollection"}, "'features'"),
     ({"type": "FeatureCollection", "features": {}}, "'features'"),
     ({"type": "FeatureCollection", "features": [None]}, "features[0] must be a GeoJSON Feature"),
-    ({"type": "FeatureCollection", "features": [feature([1, 2]), {"type": "Feature", "geometry": {"type": "LineString", "coordinates": [[1, 2], [3, 4]]}}]},
+    ({"type": "FeatureCollection",
+      "features": [feature([1, 2]),
+                   {"type": "Feature", "geometry": {"type": "LineString", "coordinates": [[1, 2], [3, 4]]}}]},
      "features[1].geometry must be a Point"),
     ({"type": "FeatureCollection", "features": [feature([1])]}, "features[0].geometry.coordinates"),
     ({"type": "FeatureCollection", "features": [feature([1, 2, 3, 4])]}, "features[0].geometry.coordinates"),

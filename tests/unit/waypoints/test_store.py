@@ -6,7 +6,6 @@ import sqlite3
 import pytest
 
 from rover_web.storage.db import Database
-from rover_web.web.validate import InvalidInput
 from rover_web.waypoints.store import (
     MissionFull,
     StaleRevision,
@@ -16,6 +15,7 @@ from rover_web.waypoints.store import (
     check_lat,
     check_lng,
 )
+from rover_web.web.validate import InvalidInput
 
 
 @pytest.fixture
