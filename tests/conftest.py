@@ -277,6 +277,7 @@ class PageWatch:
     """Every request that would leave 127.0.0.1 is blocked and recorded; console errors are kept."""
 
     LOCAL_PREFIXES = ("http://127.0.0.1", "http://localhost", "ws://127.0.0.1", "ws://localhost",
+                      "https://127.0.0.1", "https://localhost", "wss://127.0.0.1", "wss://localhost",
                       "data:", "blob:", "about:")
 
     def __init__(self, page):
@@ -298,7 +299,10 @@ class PageWatch:
 
 @pytest.fixture
 def page(browser):
-    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    # bypass_csp: Playwright's wait_for_function compiles its predicate in the page, which the
+    # app's Content-Security-Policy forbids (no 'unsafe-eval'). tests/browser/test_csp.py loads
+    # every page with the policy on and checks that nothing the app itself does is refused.
+    context = browser.new_context(viewport={"width": 1280, "height": 900}, bypass_csp=True)
     pg = context.new_page()
     pg.watch = PageWatch(pg)
     yield pg

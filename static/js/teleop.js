@@ -8,6 +8,7 @@
 // the robot again.
 import { on } from './live.js';
 import { operatorName, setOperatorName } from './operator.js';
+import { setEstopSender } from './teleop_link.js';
 
 const card = document.getElementById('teleop-card');
 if (card) start();
@@ -39,6 +40,19 @@ function start() {
   const text = (id, value) => { const el = $(id); if (el) el.textContent = value; };
 
   function message(msg) { text('teleop-message', msg); }
+
+  // The server decides who may drive; a viewer's page does not even open the socket.
+  if (document.body.dataset.canOperate === 'no') {
+    card.dataset.mode = 'read-only';
+    text('teleop-link', 'view only');
+    message(card.dataset.readonlyReason || 'Driving needs the operator role.');
+    on('teleop', (s) => {
+      text('teleop-linear', s.linear_mps.toFixed(2));
+      text('teleop-angular', s.angular_rps.toFixed(2));
+      text('teleop-holder', s.holder ? s.holder.name : 'free');
+    });
+    return;
+  }
 
   function send(obj) {
     if (ws && ws.readyState === WebSocket.OPEN) ws.send(JSON.stringify(obj));
@@ -116,13 +130,24 @@ function start() {
       estop = m.estop;
       if (m.reason === 'deadman') message('Stopped: no input reached the server in time.');
       else if (m.reason === 'taken_over' && !inControl) message('Another operator took control.');
-      else if (m.reason === 'in_control' || m.reason === 'estop_released') message('');
+      else if (m.reason === 'in_control') message('');
+      else if (m.reason === 'estop_released') {
+        message(m.armed === false && wanted() ? 'E-stop released: release the stick (or keys) to re-arm.' : '');
+      }
       render();
       if (wanted()) sendDrive();  // still held: the new epoch makes this a fresh, live input
+    } else if (m.type === 'error' && m.error === 'rearm_required') {
+      message('E-stop released: release the stick (or keys) to re-arm.');
     } else if (m.type === 'error' && m.error !== 'stale_epoch') {
       message(m.message);
     }
   }
+
+  setEstopSender(() => {
+    if (!ws || ws.readyState !== WebSocket.OPEN) return false;
+    ws.send(JSON.stringify({ estop: true }));
+    return true;
+  });
 
   function connect() {
     const scheme = location.protocol === 'https:' ? 'wss:' : 'ws:';

@@ -257,14 +257,14 @@ def subscribe_cmd_vel(peer, type_name: str = TWIST, topic: str = "/cmd_vel") -> 
     peer.wait_match(topic)
 
 
-def warm_up(peer, base_url: str, topic: str = "/cmd_vel", timeout: float = 10.0) -> None:
+def warm_up(peer, base_url: str, topic: str = "/cmd_vel", timeout: float = 10.0, headers: dict | None = None) -> None:
     """Discovery matches the two ends a moment apart: publish zeros (REST stop) until one arrives."""
     import requests
 
     deadline = time.monotonic() + timeout
     while not peer.received(topic):
         assert time.monotonic() < deadline, "the subscriber never received the app's /cmd_vel"
-        requests.post(base_url + "/api/teleop", json={"command": "stop"}, timeout=5)
+        requests.post(base_url + "/api/teleop", json={"command": "stop"}, timeout=5, headers=headers)
         time.sleep(0.05)
     time.sleep(0.05)
     peer.clear(topic)

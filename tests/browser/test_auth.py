@@ -1,0 +1,112 @@
+"""Sign-in in a real Chromium: the form, sign-out, a viewer's read-only dashboard, an operator
+driving the simulated rover, and the whole dashboard over HTTPS with a self-signed certificate."""
+
+import sys
+
+import pytest
+
+from rover_web.auth.tls import write_self_signed
+from rover_web.estop import EStopService
+from rover_web.teleop.service import TeleopService
+from tests.conftest import PageWatch, free_port
+from tests.support.auth import PASSWORD, add_users
+from tests.support.teleop_support import subscribe_cmd_vel, warm_up
+
+pytestmark = pytest.mark.browser
+
+
+@pytest.fixture
+def signed_server(live_server_factory, tmp_path):
+    db_path = tmp_path / "browser-auth.sqlite3"
+    tokens = add_users(db_path)
+    server = live_server_factory(ROVER_WEB_AUTH="required", ROVER_WEB_DB_PATH=str(db_path))
+    server.tokens = tokens
+    return server
+
+
+def sign_in(page, base_url, name, password=PASSWORD):
+    page.goto(base_url + "/")
+    page.wait_for_url("**/login?next=/**", wait_until="commit")
+    page.fill("input[name=username]", name)
+    page.fill("input[name=password]", password)
+    page.click("button[type=submit]")
+    page.wait_for_selector("#link-server[data-state='live']", timeout=10000)
+
+
+def test_sign_in_and_sign_out(signed_server, page):
+    page.goto(signed_server.url + "/livemap")
+    assert "/login" in page.url
+    page.fill("input[name=username]", "operator")
+    page.fill("input[name=password]", "wrong password")
+    page.click("button[type=submit]")
+    assert "wrong user name or password" in page.locator(".login-error").inner_text()
+    page.fill("input[name=password]", PASSWORD)
+    page.click("button[type=submit]")
+    page.wait_for_url("**/livemap/**", wait_until="commit")  # /livemap goes on to the default map
+    assert "operator" in page.locator(".whoami").inner_text()
+    page.click(".whoami button")
+    page.wait_for_url("**/login", wait_until="commit")
+    page.goto(signed_server.url + "/")
+    assert "/login" in page.url
+
+
+def test_a_viewer_sees_a_read_only_dashboard_and_may_still_stop_the_robot(signed_server, page):
+    sign_in(page, signed_server.url, "viewer")
+    assert page.locator("#teleop-card").get_attribute("data-mode") == "read-only"
+    assert "driving needs the operator role" in page.locator("#teleop-message").inner_text()
+    assert page.locator("#readonly-banner").is_visible()
+    send = page.locator("#wp-send")
+    assert send.is_disabled() and "operator role" in send.get_attribute("title")
+    assert page.locator("#estop-release").is_disabled()
+    page.click("#estop-engage")
+    page.wait_for_selector("#estop[data-engaged='yes'][data-unconfirmed='no']", timeout=5000)
+    assert signed_server.rover.feature(EStopService).engaged
+    assert signed_server.rover.feature(EStopService).state()["by"] == "viewer"
+    assert page.watch.console_errors == [], page.watch.console_errors
+
+
+def test_an_operator_drives_the_simulated_rover(signed_server, page, ros_peer, sim_process):
+    sim_process()
+    peer = ros_peer()
+    subscribe_cmd_vel(peer)
+    warm_up(peer, signed_server.url, headers={"Authorization": f"Bearer {signed_server.tokens['operator']}"})
+    sign_in(page, signed_server.url, "operator")
+    page.wait_for_selector("#teleop-link[data-state='live']", timeout=10000)
+    assert "operator" in page.locator("#teleop-link").inner_text()
+    page.keyboard.down("KeyW")
+    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] > 0, timeout=5)
+    page.wait_for_function("Number(document.getElementById('odom-linear').textContent) > 0.5", timeout=10000)
+    page.keyboard.up("KeyW")
+    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == 0.0, timeout=2)
+    assert signed_server.rover.feature(TeleopService).controller.state()["last_stop"] is not None
+
+
+def test_the_whole_dashboard_over_https_with_a_self_signed_certificate(server_process, browser, tmp_path, ros_peer):
+    cert, key = write_self_signed(tmp_path / "tls", ["127.0.0.1"])
+    db_path = tmp_path / "https.sqlite3"
+    add_users(db_path, "operator")
+    port = free_port()
+    server = server_process(port=port, scheme="https", ca=cert.parent / "ca.pem", env={
+        "ROVER_WEB_AUTH": "required", "ROVER_WEB_DB_PATH": str(db_path)},
+        args=[sys.executable, "-m", "flask", "--app", "rover_web", "run", "--no-reload", "--host", "127.0.0.1",
+              "--port", str(port), "--cert", str(cert), "--key", str(key)]).start()
+    peer = ros_peer()
+    subscribe_cmd_vel(peer)
+    context = browser.new_context(viewport={"width": 1280, "height": 900}, ignore_https_errors=True)
+    try:
+        page = context.new_page()
+        watch = PageWatch(page)
+        sign_in(page, server.url, "operator")
+        assert page.url.startswith("https://")
+        page.wait_for_selector("#teleop-link[data-state='live']", timeout=10000)  # wss:// through TLS
+        assert page.evaluate("window.isSecureContext") is True  # what the Gamepad API needs
+        page.keyboard.down("KeyW")
+        peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] > 0, timeout=5)
+        page.keyboard.up("KeyW")
+        peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == 0.0, timeout=2)
+        page.click("#estop-engage")
+        page.wait_for_selector("#estop[data-engaged='yes'][data-unconfirmed='no']", timeout=5000)
+        assert watch.offhost == [] and watch.console_errors == [], (watch.offhost, watch.console_errors)
+    finally:
+        context.close()
+
