@@ -1,17 +1,19 @@
-// One EventSource per page (browsers allow six HTTP/1.1 connections per host across all tabs).
-// Modules register handlers with on(channel, fn); the stream opens once the page's modules ran.
+// The page's side of the live event stream: modules register handlers with on(channel, fn), and
+// the link-health pills say how the stream is doing. The stream opens once the page's modules ran,
+// and it is shared with the browser's other rover_web tabs (shared_stream.js).
 // The `status` channel doubles as a heartbeat: silence means the link is stalled even if the
 // socket looks open.
+
+import { openStream } from './shared_stream.js';
 
 const handlers = new Map();
 const stateHandlers = new Set();
 const LOST_AFTER_MS = 4000;
 
-let source = null;
+let stream = null;
 let serverState = 'connecting';
 let lastMessageAt = 0;
 let troubleSince = 0;
-let reopenTimer = null;
 
 const statusPeriodMs = () => 1000 * Number(document.body.dataset.statusPeriodS || 1);
 
@@ -44,32 +46,43 @@ function setServerState(state) {
 
 const ROBOT_LABELS = { ok: 'ok', degraded: 'degraded', stale: 'stale', no_data: 'no data' };
 
-function dispatch(channel, event) {
+// raw: the event's JSON text, id: its id ('' for none). Handlers get (data, {type, data, lastEventId}).
+function dispatch(channel, raw, id) {
   lastMessageAt = performance.now();
   troubleSince = 0;
   setServerState('live');
   let data;
-  try { data = JSON.parse(event.data); } catch { return; }
+  try { data = JSON.parse(raw); } catch { return; }
   if (channel === 'status') setPill('link-robot', data.robot_link, ROBOT_LABELS[data.robot_link] || data.robot_link);
+  const event = { type: channel, data: raw, lastEventId: id };
   for (const fn of handlers.get(channel) || []) {
     try { fn(data, event); } catch (err) { console.warn(`handler for ${channel} failed`, err); }
   }
 }
 
+function trouble() {
+  if (!troubleSince) troubleSince = performance.now();
+  if (serverState === 'live' || serverState === 'connecting') setServerState('reconnecting');
+}
+
+const ROLE_TITLES = {
+  leader: 'this tab holds the stream for every rover_web tab of this browser',
+  follower: 'the stream comes from another rover_web tab of this browser',
+  own: 'this tab has a stream of its own (tabs share one only over https or on localhost)',
+};
+
+function showRole(role) {
+  const pill = document.getElementById('link-server');
+  if (!pill) return;
+  pill.dataset.role = role;
+  pill.title = `browser to server: the live event stream; ${ROLE_TITLES[role]}`;
+}
+
 function open() {
-  clearTimeout(reopenTimer);
-  if (source) source.close();
   const channels = new Set((document.body.dataset.channels || 'status').split(',').filter(Boolean));
   channels.add('status');
   for (const ch of handlers.keys()) channels.add(ch);
-  source = new EventSource(`/api/events?channels=${[...channels].join(',')}`);
-  for (const ch of channels) source.addEventListener(ch, (ev) => dispatch(ch, ev));
-  source.onerror = () => {
-    if (!troubleSince) troubleSince = performance.now();
-    if (serverState === 'live' || serverState === 'connecting') setServerState('reconnecting');
-    // A CLOSED EventSource (e.g. the server answered with an error page) never retries by itself.
-    if (source.readyState === EventSource.CLOSED) reopenTimer = setTimeout(open, 1000);
-  };
+  stream = openStream(channels, { event: dispatch, trouble, role: showRole });
 }
 
 function watchdog() {
@@ -77,7 +90,7 @@ function watchdog() {
   if (serverState === 'live' && now - lastMessageAt > 3 * statusPeriodMs()) {
     troubleSince = now;
     setServerState('reconnecting');
-    open();  // a silent stream (proxy, suspended laptop) is replaced, not waited on
+    stream.restart();  // a silent stream (proxy, suspended laptop) is replaced, not waited on
   }
   if (troubleSince && now - troubleSince > LOST_AFTER_MS) setServerState('lost');
 }

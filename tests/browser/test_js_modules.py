@@ -1,5 +1,5 @@
 """The pages' shared and pure ES modules, imported on their own in Chromium: api.js against real and
-fake answers, and the LiveMap's geometry and view maths against rover_web/map_geometry.py."""
+fake answers, and the LiveMap's geometry and view maths against rover_web/livemap/geometry.py."""
 
 import math
 from urllib.parse import quote
