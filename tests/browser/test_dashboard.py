@@ -16,7 +16,8 @@ def test_dashboard_loads_with_nothing_off_host_and_no_console_errors(live_server
 
 
 def test_dashboard_fits_a_phone(live_server, browser):
-    context = browser.new_context(viewport={"width": 375, "height": 740}, is_mobile=True, has_touch=True)
+    context = browser.new_context(viewport={"width": 375, "height": 740}, is_mobile=True, has_touch=True,
+                                  bypass_csp=True)
     try:
         phone = context.new_page()
         phone.goto(live_server.url + "/")

@@ -232,7 +232,7 @@ def test_switching_maps(live_server, page):
 
 
 def test_zoom_with_buttons_wheel_and_pinch_and_pan_by_dragging(live_server, browser):
-    context = browser.new_context(viewport={"width": 1280, "height": 900}, has_touch=True)
+    context = browser.new_context(viewport={"width": 1280, "height": 900}, has_touch=True, bypass_csp=True)
     try:
         page = context.new_page()
         s0 = open_map(page, live_server.url)
@@ -322,7 +322,8 @@ def test_dashboard_thumbnail_shows_the_robot_and_links_to_the_map(live_server, p
 
 
 def test_the_map_page_fits_a_phone(live_server, browser):
-    context = browser.new_context(viewport={"width": 375, "height": 740}, is_mobile=True, has_touch=True)
+    context = browser.new_context(viewport={"width": 375, "height": 740}, is_mobile=True, has_touch=True,
+                                  bypass_csp=True)
     try:
         phone = context.new_page()
         open_map(phone, live_server.url)

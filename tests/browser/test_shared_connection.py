@@ -45,7 +45,7 @@ COLLECT = """async (channel) => {
 
 @pytest.fixture
 def context(browser):
-    ctx = browser.new_context(viewport={"width": 1280, "height": 900})
+    ctx = browser.new_context(viewport={"width": 1280, "height": 900}, bypass_csp=True)
     ctx.console_errors = []
     ctx.on("console", lambda m: m.type == "error" and ctx.console_errors.append(m.text))
     yield ctx

@@ -216,7 +216,7 @@ def test_estop_is_on_every_page_and_follows_other_browsers(app_factory, page):
 
 def test_second_browser_is_view_only_and_can_take_over(rig, browser):
     server, peer = rig
-    ctx_a, ctx_b = browser.new_context(), browser.new_context()
+    ctx_a, ctx_b = browser.new_context(bypass_csp=True), browser.new_context(bypass_csp=True)
     try:
         a, b = ctx_a.new_page(), ctx_b.new_page()
         for p, name in ((a, "alice"), (b, "bob")):

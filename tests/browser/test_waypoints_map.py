@@ -53,7 +53,7 @@ def test_click_adds_drag_moves_delete_removes_and_other_browsers_follow(live_ser
     requests_seen = []
     page.on("request", lambda r: requests_seen.append(r.url))
     open_map(page, server.url)
-    other_context = browser.new_context(viewport={"width": 1280, "height": 900})
+    other_context = browser.new_context(viewport={"width": 1280, "height": 900}, bypass_csp=True)
     try:
         other = other_context.new_page()
         other.watch = type(page.watch)(other)
