@@ -68,6 +68,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     from rover_web.web import pages, sse, status
 
     runtime = RosRuntime(settings["ROVER_WEB_NODE_NAME"], settings["ROVER_WEB_ROS_DOMAIN_ID"])
+    rover = None
     try:
         cmd_vel = CmdVelOutput(runtime, settings["ROVER_WEB_CMD_VEL_TOPIC"],
                                max_linear_mps=settings["ROVER_WEB_MAX_LINEAR_MPS"],
@@ -93,7 +94,12 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         camera.init_app(app, rover)
         topics.init_app(app, rover)
     except BaseException:
-        runtime.stop(0.5)
+        # A feature that failed to start may follow others that already started loops and
+        # threads: stop them all in order, not just the node under them.
+        if rover is not None:
+            rover.shutdown()
+        else:
+            runtime.stop(0.5)
         raise
     app.register_blueprint(pages.bp)
     app.register_blueprint(status.bp)

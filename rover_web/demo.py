@@ -30,6 +30,7 @@ def main(argv: list[str] | None = None) -> int:
         os.environ["ROVER_WEB_HOST"] = args.host
 
     from rover_web import create_app
+    from rover_web.core.state import rover_of
 
     app = create_app()
     config = app.config
@@ -45,7 +46,7 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         pass
     finally:
-        app.extensions["rover_web"].shutdown()
+        rover_of(app).shutdown()
         if sim.poll() is None:
             # Ctrl-C in a terminal reaches the simulator too; SIGTERM covers every other way we stop.
             sim.send_signal(signal.SIGTERM)

@@ -206,7 +206,8 @@ class SimProcess:
         if "simulator running" not in line:
             raise RuntimeError(f"simulator did not start: {line}{self.proc.stdout.read()}")
         self.output: list[str] = []
-        threading.Thread(target=self._drain, daemon=True).start()
+        self._drainer = threading.Thread(target=self._drain, daemon=True)
+        self._drainer.start()
 
     def _drain(self) -> None:
         for line in self.proc.stdout:
@@ -221,7 +222,10 @@ class SimProcess:
                 self.proc.wait(10)
             except subprocess.TimeoutExpired:
                 self.proc.kill()
-        return self.proc.wait(5)
+        code = self.proc.wait(5)
+        self._drainer.join(5)  # reads to the end of the pipe once the process is gone
+        self.proc.stdout.close()
+        return code
 
 
 @pytest.fixture

@@ -126,11 +126,16 @@ class Rover:
         self.runtime.stop(self.config["ROVER_WEB_SHUTDOWN_TIMEOUT_S"])
 
 
-def current_rover() -> Rover:
-    rover = current_app.extensions.get(EXTENSION)
+def rover_of(app) -> Rover:
+    """The app's Rover, outside a request too (the demo, gunicorn's hooks, tests)."""
+    rover = app.extensions.get(EXTENSION)
     if rover is None:
         raise NotSetUp("this Flask app has no rover_web state: build it with rover_web.create_app()")
     return rover
+
+
+def current_rover() -> Rover:
+    return rover_of(current_app)
 
 
 def current_feature(cls: type[T]) -> T:
