@@ -48,8 +48,9 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("NODE_NAME", "rover_web", "str", "name of the app's ROS 2 node"),
     Setting("ROS_DOMAIN_ID", None, "optional_int",
             "ROS domain id for the app's node; unset uses ROS_DOMAIN_ID from the environment (or 0)", 0, 232),
-    Setting("HOST", "127.0.0.1", "str",
-            "address `python -m rover_web.demo` and gunicorn.conf.py bind to; 0.0.0.0 exposes the GUI to the network"),
+    Setting("HOST", None, "optional_str",
+            "address the demo and gunicorn.conf.py bind to (unset: 127.0.0.1); under another server, where it "
+            "listens, or sign-in stays required (ROVER_WEB_AUTH=auto); 0.0.0.0 exposes the GUI"),
     Setting("PORT", 5000, "int", "port `python -m rover_web.demo` and gunicorn.conf.py listen on", 1, 65535),
     Setting("SHUTDOWN_TIMEOUT_S", 2.0, "float", "how long shutdown waits for the executor thread", 0.1, 30),
     Setting("DB_PATH", None, "optional_str",

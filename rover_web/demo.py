@@ -26,15 +26,19 @@ def main(argv: list[str] | None = None) -> int:
     if args.domain_id is not None:
         os.environ["ROS_DOMAIN_ID"] = str(args.domain_id)
     os.environ.setdefault("ROS_DOMAIN_ID", "42")
-    if args.host:  # before create_app: whether sign-in is needed depends on where we listen
-        os.environ["ROVER_WEB_HOST"] = args.host
 
+    from rover_web import config as config_module
     from rover_web import create_app
     from rover_web.core.state import rover_of
 
+    # Said before create_app: whether sign-in is required depends on where the GUI listens.
+    try:
+        host = args.host or config_module.load()["ROVER_WEB_HOST"] or "127.0.0.1"
+    except config_module.ConfigError as exc:
+        raise SystemExit(f"rover_web: {exc}") from None
+    os.environ["ROVER_WEB_HOST"] = host
     app = create_app()
     config = app.config
-    host = config["ROVER_WEB_HOST"]
     port = args.port or config["ROVER_WEB_PORT"]
     tls = (config["ROVER_WEB_TLS_CERT"], config["ROVER_WEB_TLS_KEY"]) if config["ROVER_WEB_TLS_CERT"] else None
     scheme = "https" if tls else "http"

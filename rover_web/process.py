@@ -93,11 +93,12 @@ def listen_hosts(settings) -> list[str]:
     """The addresses the server will listen on, as far as the app can know before it serves.
 
     `flask run --host` is read from its command line; the demo and gunicorn.conf.py bind to
-    ROVER_WEB_HOST (gunicorn.conf.py copies a `-b` given on gunicorn's command line into it).
+    ROVER_WEB_HOST and set it (gunicorn.conf.py copies a `-b` given on gunicorn's command line
+    into it). Under any other server it is unknown unless set: [] then, and sign-in is required.
     """
     import click
 
     ctx = click.get_current_context(silent=True)
     if ctx is not None and ctx.info_name == "run" and "host" in ctx.params:
         return [ctx.params["host"] or "127.0.0.1"]
-    return [h.strip() for h in str(settings["ROVER_WEB_HOST"]).split(",") if h.strip()]
+    return [h.strip() for h in str(settings["ROVER_WEB_HOST"] or "").split(",") if h.strip()]

@@ -34,6 +34,15 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
+@pytest.fixture(autouse=True)
+def _close_teleop_clients():
+    """Teleop test clients a test left open are closed, not left to the garbage collector."""
+    yield
+    from tests.support.teleop_support import close_open_clients
+
+    close_open_clients()
+
+
 @pytest.fixture
 def app_factory(tmp_path):
     """Make apps with test settings; every app made is shut down at the end of the test."""
@@ -43,7 +52,8 @@ def app_factory(tmp_path):
 
     def make(**settings):
         config = {"TESTING": True, "ROVER_WEB_DB_PATH": str(tmp_path / f"rover_web{len(made)}.sqlite3"),
-                  "ROVER_WEB_SECRET_KEY": "tests"}  # not a key file in the checkout's instance folder
+                  "ROVER_WEB_SECRET_KEY": "tests",  # not a key file in the checkout's instance folder
+                  "ROVER_WEB_HOST": "127.0.0.1"}  # where the in-process test servers listen
         config.update(settings)
         app = create_app(config)
         made.append(app)

@@ -10,7 +10,7 @@ from rover_web.core.state import current_feature
 from rover_web.web.http import ApiError, accepts_form, error_response, json_body, wants_json
 from rover_web.web.validate import InvalidInput, only_keys, text
 
-from .accounts import AccountError
+from .accounts import AccountError, check_password, check_role
 from .identity import SignedIn
 from .policy import required_role, role_allows
 from .service import AuthService
@@ -161,10 +161,14 @@ def admin_update_user(name: str):
         password = text(body, "password", max_len=1024, default=None)
         if accounts.get(name) is None:
             raise AccountError(f"no user {name!r}", "no_such_user")
+        # Both checked before either is written: a bad password must not leave a changed role.
+        if role is not None:
+            check_role(role)
+        if password is not None:
+            check_password(password)
+            accounts.set_password(name, password)
         if role is not None:
             accounts.set_role(name, role)
-        if password is not None:
-            accounts.set_password(name, password)
     except InvalidInput as exc:
         raise ApiError(400, exc.code, str(exc)) from None
     except AccountError as exc:

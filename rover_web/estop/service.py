@@ -1,9 +1,9 @@
 """The e-stop: one latch that stops everything the GUI can start.
 
 Engaging stops the robot before anything else, without waiting on a lock that I/O holds: zero
-velocity goes out, every feature's engage hook runs (teleop drops its drivers, panels send their
-`on_estop` command), `/e_stop` says true, and every navigation action is asked to cancel its goals.
-The latch is written to disk after that. While engaged, zero velocity goes out at the teleop rate
+velocity goes out, `/e_stop` says true, every navigation action is asked to cancel its goals, and
+every feature's engage hook runs (teleop drops its drivers, panels send their `on_estop` command
+and then log it). The latch is written to disk after that. While engaged, zero velocity goes out at the teleop rate
 and every request that would publish motion is refused (`check_motion`).
 
 Releasing is written to disk first, and only then allowed: if an engage arrives while that write
@@ -53,7 +53,7 @@ class EStopService:
         self._clock = clock
         loaded = store.load()
         self._engaged = bool(loaded["engaged"])
-        self._state = {**loaded, "persisted": True, "cancel": None}
+        self._state = {**loaded, "via": None, "persisted": True, "cancel": None}
         self._epoch = 0  # +1 per engage, so a release can tell that one came while it wrote
         self._lock = threading.Lock()  # guards the state in memory; never held across I/O
         self._release_lock = threading.Lock()  # one release at a time (engaging never takes it)
@@ -97,12 +97,10 @@ class EStopService:
                 self._state = {"engaged": True, "since": self._clock(), "by": by, "via": via, "persisted": None,
                                "cancel": None}
             state = dict(self._state)
-        self._stop_everything(by)
+        self._stop_everything(by, cancel_goals=first)
         if not first:
             return self.state()
         log.warning("e-stop engaged by %s (%s)", by, via)
-        if self._canceller is not None:
-            self._canceller.cancel_all(self._goals_canceled)
         persisted = self._persist(state)
         with self._lock:
             if self._state.get("since") == state["since"]:
@@ -155,14 +153,17 @@ class EStopService:
 
     # --- internals ---
 
-    def _stop_everything(self, by: str) -> None:
+    def _stop_everything(self, by: str, cancel_goals: bool) -> None:
+        # What needs no disk first; hooks last, since one may write a log entry.
         try:
             self._zero()
         except Exception:
             log.exception("e-stop: zero velocity could not be published")
+        self._publish_flag_safely(True)
+        if cancel_goals and self._canceller is not None:
+            self._canceller.cancel_all(self._goals_canceled)
         for hook in self._engage_hooks:
             self._run_hook(hook, by)
-        self._publish_flag_safely(True)
 
     def _persist(self, state: dict) -> bool:
         try:

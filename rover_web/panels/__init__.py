@@ -26,6 +26,7 @@ def init_app(app, rover: Rover) -> None:
     service = PanelService(specs, rover, OperatorLog(rover.db, config["ROVER_WEB_PANELS_LOG_KEEP"]), estop)
     rover.add_feature(service)
     estop.on_engage(service.on_estop)
+    estop.on_release(lambda _by: service.publish_view())  # the page's buttons come back
     app.register_blueprint(routes.bp)
     rover.add_panel(20, "panels/panels.html", "Control panels", channels=("panel",))
     rover.add_nav("Panels", "/panels")

@@ -61,7 +61,7 @@ class PanelService:
         self.oplog = oplog
         self.estop = estop
         self.specs = {s.id: s for s in specs}
-        self.states = {s.id: PanelState(s) for s in specs}
+        self.states = {s.id: PanelState(s, estop_engaged=lambda: estop.engaged) for s in specs}
         self._view_lock = threading.Lock()
         self._last_view: dict | None = None
         runtime = rover.runtime
@@ -181,10 +181,6 @@ class PanelService:
                 "confirmation_required"), client)
         with state.lock:
             self._expire(state)
-            if self.estop.engaged and not control.allowed_during_estop:
-                self._refuse(state, control, value, "refused", CommandRefused(
-                    f"the e-stop is engaged: {control.label} is not sent until it is released", "estop_engaged"),
-                    client)
             refusal = state.refusal(control)
             if refusal is not None:
                 self._refuse(state, control, value, "refused", CommandRefused(refusal.reason, refusal.code), client)

@@ -45,9 +45,11 @@ def _format(value: Any, digits: int) -> str:
 
 
 class PanelState:
-    def __init__(self, spec: PanelSpec, clock: Callable[[], float] = time.monotonic):
+    def __init__(self, spec: PanelSpec, clock: Callable[[], float] = time.monotonic,
+                 estop_engaged: Callable[[], bool] = lambda: False):
         self.spec = spec
         self._clock = clock
+        self._estop_engaged = estop_engaged
         self._lock = threading.RLock()
         self._values: dict[str, Any] = {}
         self._received_at: dict[str, float] = {}
@@ -112,9 +114,12 @@ class PanelState:
     # --- rules ---
 
     def refusal(self, control: ControlSpec, now: float | None = None) -> Refusal | None:
-        """None if `control` may be used now, else the reason (the lock first, then the displays)."""
+        """None if `control` may be used now, else the reason (the e-stop, the lock, then the displays)."""
         now = self._clock() if now is None else now
         with self._lock:
+            if self._estop_engaged() and not control.allowed_during_estop:
+                return Refusal("estop_engaged", f"the e-stop is engaged: {control.label} is not sent until it is "
+                                                "released")
             if control.requires_unlock and self.locked(now):
                 return Refusal("locked", f"the {self.spec.title} panel is locked; unlock it first")
             for display_id, allowed in control.enabled_when:
@@ -204,6 +209,7 @@ def control_description(c: ControlSpec) -> dict:
     out["enabled_when"] = {did: list(values) for did, values in c.enabled_when}
     out["confirm"] = c.confirm
     out["requires_unlock"] = c.requires_unlock
+    out["allowed_during_estop"] = c.allowed_during_estop
     return out
 
 

@@ -43,3 +43,4 @@ def test_demo_serves_the_simulated_robot_and_one_ctrl_c_stops_everything(tmp_pat
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
             proc.wait(5)
+        proc.stdout.close()

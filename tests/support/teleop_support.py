@@ -13,6 +13,16 @@ TWIST = "geometry_msgs/msg/Twist"
 TWIST_STAMPED = "geometry_msgs/msg/TwistStamped"
 
 
+# Every client not yet closed; conftest closes what a test left open (a socket left to the
+# garbage collector is a ResourceWarning, and warnings are errors).
+OPEN_CLIENTS: set = set()
+
+
+def close_open_clients() -> None:
+    for client in list(OPEN_CLIENTS):
+        client.close()
+
+
 class TeleopClient:
     """websocket-client on /ws/teleop with a reader thread that keeps every message received."""
 
@@ -29,6 +39,7 @@ class TeleopClient:
         self._stop = threading.Event()
         self._reader = threading.Thread(target=self._read, daemon=True)
         self._reader.start()
+        OPEN_CLIENTS.add(self)
         self.hello = self.wait_for(lambda m: m["type"] == "hello")
 
     def _read(self) -> None:
@@ -123,15 +134,18 @@ class TeleopClient:
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
         t = time.monotonic()
         sock.close()
+        OPEN_CLIENTS.discard(self)
         return t
 
     def close(self) -> None:
+        OPEN_CLIENTS.discard(self)
         self._stop.set()
         self._reader.join(2)
         try:
             self.ws.close(timeout=1)
         except Exception:
-            self.ws.shutdown()
+            pass
+        self.ws.shutdown()  # closes the socket even when the close handshake did not complete
 
 
 class StallingProxy:

@@ -43,7 +43,8 @@ def test_without_credentials_apis_answer_401_and_pages_redirect_to_the_form(sign
     page = client.get("/livemap")
     assert page.status_code == 302 and page.headers["Location"].startswith("/login?next=/livemap")
     assert client.get("/login").status_code == 200
-    assert client.get("/static/css/app.css").status_code == 200
+    with client.get("/static/css/app.css") as static_file:
+        assert static_file.status_code == 200
 
 
 def test_sign_in_sets_a_strict_http_only_cookie_and_sign_out_ends_it(signed_app):
@@ -141,12 +142,13 @@ def test_admin_manages_users_over_the_api(signed_app):
 
 def test_security_headers_on_every_response(signed_app):
     client = signed_app.test_client()
-    for response in (client.get("/login"), client.get("/api/status"), client.get("/static/js/api.js")):
-        assert "default-src 'self'" in response.headers["Content-Security-Policy"]
-        assert "frame-ancestors 'none'" in response.headers["Content-Security-Policy"]
-        assert response.headers["X-Frame-Options"] == "DENY"
-        assert response.headers["X-Content-Type-Options"] == "nosniff"
-        assert response.headers["Referrer-Policy"] == "same-origin"
+    for path in ("/login", "/api/status", "/static/js/api.js"):
+        with client.get(path) as response:
+            assert "default-src 'self'" in response.headers["Content-Security-Policy"]
+            assert "frame-ancestors 'none'" in response.headers["Content-Security-Policy"]
+            assert response.headers["X-Frame-Options"] == "DENY"
+            assert response.headers["X-Content-Type-Options"] == "nosniff"
+            assert response.headers["Referrer-Policy"] == "same-origin"
 
 
 def test_the_session_key_is_made_once_and_kept_private(tmp_path):
@@ -154,3 +156,18 @@ def test_the_session_key_is_made_once_and_kept_private(tmp_path):
     assert len(key) == 64 and secret_key(None, str(tmp_path)) == key
     assert (tmp_path / "secret_key").stat().st_mode & 0o077 == 0
     assert secret_key("configured", str(tmp_path)) == "configured"
+
+
+def test_a_refused_user_change_changes_nothing(signed_app):
+    client = signed_app.test_client()
+    admin = {"Authorization": f"Bearer {signed_app.tokens['admin']}"}
+    refused = client.patch("/api/users/viewer", json={"role": "admin", "password": "short"}, headers=admin)
+    assert refused.status_code == 400 and refused.get_json()["error"] == "bad_password"
+    assert client.get("/api/users", headers=admin).get_json()["users"][-1] == {
+        "name": "viewer", "role": "viewer", "created_at": pytest.approx(0, abs=1e12), "tokens": 1}
+
+
+def test_under_a_server_that_does_not_say_where_it_listens_sign_in_stays_required(app_factory):
+    """auto fails closed: no flask run --host, no ROVER_WEB_HOST (another WSGI server)."""
+    with pytest.raises(ConfigError, match="sign-in is required"):
+        app_factory(ROVER_WEB_HOST=None)

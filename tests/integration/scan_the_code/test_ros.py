@@ -74,6 +74,7 @@ class BuoyProcess:
                 self.proc.kill()
                 self.proc.wait(5)
         self._drain.join(5)
+        self.proc.stdout.close()
         return "".join(self.output)
 
 

@@ -66,12 +66,12 @@ def make(db, robot, store=None, canceller=None):
                         on_change=robot.changes.append)
 
 
-def test_engage_stops_first_then_hooks_then_says_so_on_ros_then_records(db):
+def test_engage_stops_first_then_says_so_on_ros_then_hooks_then_records(db):
     robot = Robot()
     estop = make(db, robot)
     estop.on_engage(lambda by: robot.events.append(f"hook:{by}"))
     state = estop.engage("ada", via="api")
-    assert robot.events == ["zero", "hook:ada", "flag:True"]
+    assert robot.events == ["zero", "flag:True", "hook:ada"]
     assert state["engaged"] and state["by"] == "ada" and state["via"] == "api" and state["persisted"] is True
     assert EStopStore(db).load()["engaged"] is True
     assert robot.changes[-1]["engaged"]
@@ -186,7 +186,7 @@ def test_a_failing_hook_does_not_keep_the_others_or_the_flag_from_running(db):
     estop.on_engage(lambda by: 1 / 0)
     estop.on_engage(lambda by: robot.events.append("second hook"))
     estop.engage("ada")
-    assert robot.events == ["zero", "second hook", "flag:True"]
+    assert robot.events == ["zero", "flag:True", "second hook"]
 
 
 def test_goal_cancel_outcomes_join_the_state(db):

@@ -156,3 +156,20 @@ def test_detail_lists_configuration_and_ages(drone):
     destination = next(c for c in detail["controls"] if c["id"] == "destination")
     assert (destination["min"], destination["max"], destination["action"]) == (0, 127, "Start")
     assert detail["light"]["state"] == "green"
+
+
+
+def test_the_e_stop_refuses_every_control_but_the_allowed_ones_and_the_page_says_so():
+    (panel,) = spec.load(None, 2.0, field_kind)
+    engaged = [False]
+    state = PanelState(panel, Clock(), estop_engaged=lambda: engaged[0])
+    state.unlock()
+    assert state.refusal(control(state, "stop")) is None
+    engaged[0] = True
+    for cid in ("takeoff", "destination", "return", "height"):
+        refusal = state.refusal(control(state, cid))
+        assert refusal.code == "estop_engaged" and "e-stop" in refusal.reason
+        assert state.view()["controls"][cid] == {"enabled": False, "reason": refusal.reason}
+    assert state.refusal(control(state, "stop")) is None  # allowed_during_estop
+    assert state.view()["controls"]["stop"]["enabled"] is True
+    assert panel.on_estop == "stop"
