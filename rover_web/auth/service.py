@@ -31,9 +31,10 @@ class AuthService:
         if mode_note := self.startup_note():
             log.warning(mode_note)
         if self.required and self.accounts.count() == 0:
-            where = ", ".join(self.listen_hosts) or "an address that is not loopback"
+            where = (f"listening on {', '.join(self.listen_hosts)}" if self.listen_hosts else
+                     "this server did not say where it listens: set ROVER_WEB_HOST to its address")
             other_way = ", or listen on 127.0.0.1 only" if self.mode == "auto" else ""
-            raise ConfigError(f"sign-in is required (ROVER_WEB_AUTH={self.mode}, listening on {where}) but no user "
+            raise ConfigError(f"sign-in is required (ROVER_WEB_AUTH={self.mode}, {where}) but no user "
                               f"exists: add one with `{ADD_USER_HINT}`{other_way}")
 
     def startup_note(self) -> str | None:

@@ -117,7 +117,7 @@ def test_a_served_app_keeps_its_start_up_heap_out_of_the_collector(tmp_path):
         "served = gc.get_freeze_count()\n"
         "print(json.dumps({'testing': testing, 'served': served, 'objects': len(gc.get_objects())}))\n"
     )
-    env = subprocess_env(ROVER_WEB_DB_PATH=str(tmp_path / "db.sqlite3"))
+    env = subprocess_env(ROVER_WEB_DB_PATH=str(tmp_path / "db.sqlite3"), ROVER_WEB_HOST="127.0.0.1")
     result = subprocess.run([sys.executable, "-c", script], cwd=ROOT, env=env, capture_output=True, text=True,
                             timeout=60)
     assert result.returncode == 0, result.stderr

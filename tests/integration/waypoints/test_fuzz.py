@@ -61,7 +61,7 @@ class Harness:
     """One app (own node, real SQLite), one subscriber process, and the ledger of what must be heard."""
 
     def __init__(self, db_path):
-        self.app = create_app({"TESTING": True, "ROVER_WEB_DB_PATH": str(db_path),
+        self.app = create_app({"TESTING": True, "ROVER_WEB_DB_PATH": str(db_path), "ROVER_WEB_HOST": "127.0.0.1",
                                "ROVER_WEB_MAX_WAYPOINTS": MAX_WAYPOINTS})
         self.db_path = db_path
         self.client = self.app.test_client()
