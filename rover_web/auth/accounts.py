@@ -8,6 +8,7 @@ would only cost every curl request time without adding strength.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import hmac
 import re
@@ -42,10 +43,15 @@ CREATE TABLE IF NOT EXISTS auth_tokens (
 )
 """
 
-# A hash of a password nobody has, checked when the name is unknown, so that an unknown name
-# takes as long to refuse as a wrong password (no user enumeration by timing).
 _hasher = PasswordHasher()
-_DUMMY_HASH = _hasher.hash(secrets.token_hex(16))
+
+
+@functools.cache
+def _dummy_hash() -> str:
+    """A hash of a password nobody has, checked when the name is unknown, so that an unknown name
+    takes as long to refuse as a wrong password (no user enumeration by timing). Made at the first
+    sign-in, not at start: an Argon2 hash takes 64 MiB and tens of milliseconds."""
+    return _hasher.hash(secrets.token_hex(16))
 
 
 class AccountError(ValueError):
@@ -149,7 +155,7 @@ class Accounts:
         row = self._db.connection().execute(
             "SELECT name, role, password_hash FROM auth_users WHERE name = ?", (name,)).fetchone()
         try:
-            _hasher.verify(row["password_hash"] if row else _DUMMY_HASH, password)
+            _hasher.verify(row["password_hash"] if row else _dummy_hash(), password)
         except (VerificationError, InvalidHashError):
             return None
         if row is None:

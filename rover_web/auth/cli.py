@@ -14,7 +14,6 @@ from flask.cli import AppGroup
 from rover_web.storage.db import Database, database_path
 
 from .accounts import ROLES, AccountError, Accounts
-from .tls import default_hosts, write_self_signed
 
 users = AppGroup("users", help="Users who may sign in, and their roles (viewer, operator, admin).")
 tokens = AppGroup("tokens", help="API tokens for curl and scripts: Authorization: Bearer <token>.")
@@ -122,6 +121,8 @@ def tokens_revoke(token_id: int) -> None:
               help="where to write cert.pem and key.pem (default: the instance folder's tls/)")
 def tls_self_signed(hosts: tuple[str, ...], directory: Path | None) -> None:
     """Write a self-signed certificate and key into the instance folder."""
+    from .tls import default_hosts, write_self_signed  # cryptography: ~10 MB a server never needs
+
     directory = directory or Path(current_app.instance_path) / "tls"
     cert, key = write_self_signed(directory, list(hosts) or default_hosts())
     click.echo(f"wrote {cert} and {key}; trust {directory / 'ca.pem'} on the devices that browse to it")

@@ -12,10 +12,13 @@ from collections.abc import Callable
 
 log = logging.getLogger(__name__)
 
+# A gated loop whose gate is closed checks for shutdown this often (and not at its own rate).
+GATE_CHECK_S = 1.0
+
 
 class Loop:
     def __init__(self, name: str, period_s: float, fn: Callable[[], object], stopping: threading.Event, *,
-                 immediately: bool = False):
+                 immediately: bool = False, only_while: threading.Event | None = None):
         if not period_s > 0:
             raise ValueError(f"loop {name!r}: period_s must be positive, got {period_s!r}")
         self.name = name
@@ -23,6 +26,7 @@ class Loop:
         self._fn = fn
         self._stopping = stopping
         self._immediately = immediately
+        self._gate = only_while
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
 
     def start(self) -> Loop:
@@ -32,7 +36,12 @@ class Loop:
     def _run(self) -> None:
         if self._immediately:
             self._call()
-        while not self._stopping.wait(self.period_s):
+        while not self._stopping.is_set():
+            if self._gate is not None and not self._gate.is_set():
+                self._gate.wait(GATE_CHECK_S)  # asleep while there is nothing to do; opens at once
+                continue
+            if self._stopping.wait(self.period_s):
+                return
             self._call()
 
     def _call(self) -> None:
@@ -54,6 +63,7 @@ class Loop:
 
 
 def every(period_s: float, fn: Callable[[], object], *, name: str, stopping: threading.Event,
-          immediately: bool = False) -> Loop:
-    """Start a loop that calls `fn` every `period_s` (first right away with `immediately`)."""
-    return Loop(name, period_s, fn, stopping, immediately=immediately).start()
+          immediately: bool = False, only_while: threading.Event | None = None) -> Loop:
+    """Start a loop that calls `fn` every `period_s` (first right away with `immediately`); with
+    `only_while`, only while that event is set (a 40 Hz job that is idle most of the day)."""
+    return Loop(name, period_s, fn, stopping, immediately=immediately, only_while=only_while).start()

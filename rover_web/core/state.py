@@ -95,9 +95,11 @@ class Rover:
 
     # --- background work and shutdown ---
 
-    def every(self, period_s: float, fn: Callable[[], object], *, name: str, immediately: bool = False) -> Loop:
+    def every(self, period_s: float, fn: Callable[[], object], *, name: str, immediately: bool = False,
+              only_while: threading.Event | None = None) -> Loop:
         """A background loop that ends when the app shuts down, and is joined then."""
-        loop = every(period_s, fn, name=name, stopping=self._stopping, immediately=immediately)
+        loop = every(period_s, fn, name=name, stopping=self._stopping, immediately=immediately,
+                     only_while=only_while)
         self._loops.append(loop)
         return loop
 

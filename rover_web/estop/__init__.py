@@ -45,7 +45,8 @@ def init_app(app: Flask, rover: Rover) -> None:
     rover.hub.publish(CHANNEL, estop.state())
     estop.republish()  # a late joiner gets the latch from the transient-local history at once
     rover.every(config["ROVER_WEB_ESTOP_REPEAT_S"], estop.republish, name="estop-republish")
-    rover.every(1.0 / config["ROVER_WEB_TELEOP_RATE_HZ"], estop.hold, name="estop-hold-zero")
+    rover.every(1.0 / config["ROVER_WEB_TELEOP_RATE_HZ"], estop.hold, name="estop-hold-zero",
+                only_while=estop.engaged_event)  # asleep unless engaged: no 40 Hz wake-ups all day
 
     @app.context_processor
     def _estop_context():

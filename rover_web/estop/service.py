@@ -53,6 +53,9 @@ class EStopService:
         self._clock = clock
         loaded = store.load()
         self._engaged = bool(loaded["engaged"])
+        self.engaged_event = threading.Event()  # set while engaged: gates the zero-velocity loop
+        if self._engaged:
+            self.engaged_event.set()
         self._state = {**loaded, "via": None, "persisted": True, "cancel": None}
         self._epoch = 0  # +1 per engage, so a release can tell that one came while it wrote
         self._lock = threading.Lock()  # guards the state in memory; never held across I/O
@@ -92,6 +95,7 @@ class EStopService:
         with self._lock:
             first = not self._engaged
             self._engaged = True
+            self.engaged_event.set()
             self._epoch += 1
             if first:
                 self._state = {"engaged": True, "since": self._clock(), "by": by, "via": via, "persisted": None,
@@ -127,6 +131,7 @@ class EStopService:
                     again = dict(self._state)
                 else:
                     self._engaged = False
+                    self.engaged_event.clear()
                     self._state = {**released, "via": None, "persisted": True, "cancel": None}
                     again = None
             if again is not None:
