@@ -3,6 +3,11 @@
 An action server answers `action_msgs/srv/CancelGoal` on `<action>/_action/cancel_goal`; a
 request with a zero goal id and a zero stamp cancels every goal it has accepted. Clients are made
 once, at start, so that discovery has happened long before an e-stop needs them.
+
+They live on a small node of their own (`<app node>_estop`) with its own executor thread: on the
+app's node, rclpy would rebuild them into the main executor's wait set at every wake-up (100 Hz
+odometry and more), for a call made only when someone hits the e-stop (bench/events.py showed a
+p99 0.6 ms worse). Idle, their executor blocks and costs nothing.
 """
 
 from __future__ import annotations
@@ -10,16 +15,39 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 
+import rclpy
 from action_msgs.srv import CancelGoal
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.parameter import Parameter
 
 RETURN_CODES = {0: "canceled", 1: "rejected", 2: "no_goals", 3: "no_goals"}  # 2, 3: nothing to cancel
 
 
 class GoalCanceller:
     def __init__(self, runtime, actions: list[str]):
-        self._runtime = runtime
-        self._clients = {name: runtime.node.create_client(CancelGoal, f"{name.rstrip('/')}/_action/cancel_goal")
+        context = runtime.context
+        self._node = rclpy.create_node(
+            f"{runtime.node.get_name()}_estop", namespace=runtime.node.get_namespace(), context=context,
+            start_parameter_services=False,
+            parameter_overrides=[Parameter("start_type_description_service", value=False)])
+        self._clients = {name: self._node.create_client(CancelGoal, f"{name.rstrip('/')}/_action/cancel_goal")
                          for name in actions}
+        self._executor = SingleThreadedExecutor(context=context)
+        self._executor.add_node(self._node)
+        self._thread = threading.Thread(target=self._spin, name="estop-cancel-executor", daemon=True)
+        self._thread.start()
+        runtime.on_stop(self.close)
+
+    def _spin(self) -> None:
+        try:
+            self._executor.spin()
+        except ExternalShutdownException:
+            pass
+
+    def close(self) -> None:
+        self._executor.shutdown(timeout_sec=1.0)
+        self._thread.join(1.0)
+        self._node.destroy_node()
 
     @property
     def actions(self) -> list[str]:
@@ -72,7 +100,7 @@ class GoalCanceller:
             return
         for name, future in pending:
             future.add_done_callback(lambda f, name=name: answered(name, f))
-        self._runtime.executor.wake()
+        self._executor.wake()
         timer = threading.Timer(timeout_s, finish)
         timer.daemon = True
         timer.start()
