@@ -118,6 +118,33 @@ def live_server(live_server_factory):
     return live_server_factory()
 
 
+def _signed_settings(tmp_path) -> tuple[dict, dict]:
+    """Sign-in required, and one user per role (named after it) already in the database."""
+    from tests.support.auth import add_users
+
+    db_path = tmp_path / "signed.sqlite3"
+    tokens = add_users(db_path)
+    return {"ROVER_WEB_AUTH": "required", "ROVER_WEB_DB_PATH": str(db_path)}, tokens
+
+
+@pytest.fixture
+def signed_app(app_factory, tmp_path):
+    """An app (test client) with sign-in on; `.tokens[role]` is each user's API token."""
+    settings, tokens = _signed_settings(tmp_path)
+    app = app_factory(**settings)
+    app.tokens = tokens
+    return app
+
+
+@pytest.fixture
+def signed_server(live_server_factory, tmp_path):
+    """A live server with sign-in on; `.tokens[role]` is each user's API token."""
+    settings, tokens = _signed_settings(tmp_path)
+    server = live_server_factory(**settings)
+    server.tokens = tokens
+    return server
+
+
 class ServerProcess:
     """`flask --app rover_web run --no-reload` in its own process, as an operator starts it."""
 

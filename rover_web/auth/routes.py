@@ -124,9 +124,15 @@ def me():
 
 # --- users and tokens (admin) ---
 
-def _account_error(exc: AccountError):
+@bp.errorhandler(AccountError)
+def account_error(exc: AccountError):
     status = 404 if exc.code.startswith("no_such") else 409 if exc.code == "user_exists" else 400
     return error_response(status, exc.code, str(exc))
+
+
+@bp.errorhandler(InvalidInput)
+def invalid_input(exc: InvalidInput):
+    return error_response(400, exc.code, str(exc))
 
 
 @bp.get("/api/users")
@@ -137,15 +143,9 @@ def admin_list_users():
 @bp.post("/api/users")
 def admin_add_user():
     body = json_body()
-    try:
-        only_keys(body, {"name", "role", "password"})
-        name, role = text(body, "name", max_len=40), text(body, "role", max_len=20)
-        password = text(body, "password", max_len=1024)
-        user = _service().accounts.add_user(name, role, password)
-    except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
-    except AccountError as exc:
-        return _account_error(exc)
+    only_keys(body, {"name", "role", "password"})
+    user = _service().accounts.add_user(text(body, "name", max_len=40), text(body, "role", max_len=20),
+                                        text(body, "password", max_len=1024))
     return jsonify(name=user.name, role=user.role), 201
 
 
@@ -153,36 +153,28 @@ def admin_add_user():
 def admin_update_user(name: str):
     body = json_body()
     accounts = _service().accounts
-    try:
-        only_keys(body, {"role", "password"})
-        if not body:
-            raise InvalidInput("send 'role', 'password' or both", "missing_field")
-        role = text(body, "role", max_len=20, default=None)
-        password = text(body, "password", max_len=1024, default=None)
-        if accounts.get(name) is None:
-            raise AccountError(f"no user {name!r}", "no_such_user")
-        # Both checked before either is written: a bad password must not leave a changed role.
-        if role is not None:
-            check_role(role)
-        if password is not None:
-            check_password(password)
-            accounts.set_password(name, password)
-        if role is not None:
-            accounts.set_role(name, role)
-    except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
-    except AccountError as exc:
-        return _account_error(exc)
+    only_keys(body, {"role", "password"})
+    if not body:
+        raise InvalidInput("send 'role', 'password' or both", "missing_field")
+    role = text(body, "role", max_len=20, default=None)
+    password = text(body, "password", max_len=1024, default=None)
+    if accounts.get(name) is None:
+        raise AccountError(f"no user {name!r}", "no_such_user")
+    # Both checked before either is written: a bad password must not leave a changed role.
+    if role is not None:
+        check_role(role)
+    if password is not None:
+        check_password(password)
+        accounts.set_password(name, password)
+    if role is not None:
+        accounts.set_role(name, role)
     user = accounts.get(name)
     return jsonify(name=user.name, role=user.role)
 
 
 @bp.delete("/api/users/<name>")
 def admin_remove_user(name: str):
-    try:
-        _service().accounts.remove_user(name)
-    except AccountError as exc:
-        return _account_error(exc)
+    _service().accounts.remove_user(name)
     return jsonify(removed=name)
 
 
@@ -194,22 +186,13 @@ def admin_list_tokens():
 @bp.post("/api/tokens")
 def admin_create_token():
     body = json_body()
-    try:
-        only_keys(body, {"user", "label"})
-        user = text(body, "user", max_len=40)
-        label = text(body, "label", max_len=80, default="")
-        token_id, token = _service().accounts.create_token(user, label)
-    except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
-    except AccountError as exc:
-        return _account_error(exc)
+    only_keys(body, {"user", "label"})
+    user = text(body, "user", max_len=40)
+    token_id, token = _service().accounts.create_token(user, text(body, "label", max_len=80, default=""))
     return jsonify(id=token_id, user=user, token=token), 201
 
 
 @bp.delete("/api/tokens/<int:token_id>")
 def admin_revoke_token(token_id: int):
-    try:
-        _service().accounts.revoke_token(token_id)
-    except AccountError as exc:
-        return _account_error(exc)
+    _service().accounts.revoke_token(token_id)
     return jsonify(revoked=token_id)

@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import threading
-
 from flask import Blueprint, Response, jsonify, request
 
 from rover_web.core.state import current_feature
 from rover_web.web.connection import peer_gone
 from rover_web.web.http import ApiError, error_response
-from rover_web.web.streams import stream_slot
+from rover_web.web.streams import once, opening
 from rover_web.web.validate import InvalidInput
 
 from .mjpeg import MIMETYPE, OPENING, multipart_part
@@ -38,20 +36,10 @@ def stream_refused(exc: StreamRefused):
 @bp.get("/stream")
 def stream():
     streams = current_feature(CameraStreams)
-    slot = stream_slot("mjpeg")
-    try:
+    with opening("mjpeg") as slot:
         key = streams.key_for(request.args)
         producer = streams.acquire(key)
-    except BaseException:
-        slot.release()
-        raise
-    released = threading.Event()
-
-    def release() -> None:
-        if not released.is_set():
-            released.set()
-            streams.release(key)
-            slot.release()
+    release = once(lambda: streams.release(key), slot.release)
 
     sock = request.environ.get("werkzeug.socket") or request.environ.get("gunicorn.socket")
     stopping = streams.rover.stopping

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import threading
 import time
 
 from flask import Blueprint, Response, jsonify, render_template, request
@@ -11,7 +10,7 @@ from rover_web.camera.msgs import IMAGE_TYPES
 from rover_web.core.state import current_feature
 from rover_web.web.connection import peer_gone
 from rover_web.web.http import error_response
-from rover_web.web.streams import stream_slot
+from rover_web.web.streams import once, opening
 from rover_web.web.validate import InvalidInput, topic_name
 
 from .echo import EchoClosed, echo_event
@@ -55,20 +54,10 @@ def api_topics():
 def api_echo():
     browser = current_feature(TopicBrowser)
     rover = browser.rover
-    slot = stream_slot("topic_echo")
-    try:
+    with opening("topic_echo") as slot:
         key = browser.resolve(request.args)
         echo = browser.acquire(key)
-    except BaseException:
-        slot.release()
-        raise
-    released = threading.Event()
-
-    def release() -> None:
-        if not released.is_set():
-            released.set()
-            browser.release(key)
-            slot.release()
+    release = once(lambda: browser.release(key), slot.release)
 
     sock = request.environ.get("werkzeug.socket") or request.environ.get("gunicorn.socket")
     keepalive_s = rover.config["ROVER_WEB_SSE_KEEPALIVE_S"]

@@ -15,15 +15,6 @@ from tests.support.teleop_support import subscribe_cmd_vel, warm_up
 pytestmark = pytest.mark.browser
 
 
-@pytest.fixture
-def signed_server(live_server_factory, tmp_path):
-    db_path = tmp_path / "browser-auth.sqlite3"
-    tokens = add_users(db_path)
-    server = live_server_factory(ROVER_WEB_AUTH="required", ROVER_WEB_DB_PATH=str(db_path))
-    server.tokens = tokens
-    return server
-
-
 def sign_in(page, base_url, name, password=PASSWORD):
     page.goto(base_url + "/")
     page.wait_for_url("**/login?next=/**", wait_until="commit")

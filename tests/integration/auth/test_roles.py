@@ -9,8 +9,6 @@ import pytest
 import requests
 import websocket
 
-from tests.support.auth import add_users
-
 GEOJSON = {"type": "FeatureCollection", "features": [
     {"type": "Feature", "geometry": {"type": "Point", "coordinates": [-71.0, 42.0]}, "properties": {}}]}
 
@@ -39,15 +37,6 @@ REQUESTS = [
 ]
 RANK = {None: -1, "viewer": 0, "operator": 1, "admin": 2}
 PUBLIC = {("POST", "/login")}
-
-
-@pytest.fixture
-def signed_server(live_server_factory, tmp_path):
-    db_path = tmp_path / "roles.sqlite3"
-    tokens = add_users(db_path)
-    server = live_server_factory(ROVER_WEB_AUTH="required", ROVER_WEB_DB_PATH=str(db_path))
-    server.tokens = tokens
-    return server
 
 
 def test_the_table_names_every_state_changing_route(app):

@@ -4,16 +4,7 @@ import pytest
 
 from rover_web.auth.service import secret_key
 from rover_web.config import ConfigError
-from tests.support.auth import PASSWORD, add_users, sign_in
-
-
-@pytest.fixture
-def signed_app(app_factory, tmp_path):
-    db_path = tmp_path / "signed.sqlite3"
-    tokens = add_users(db_path)
-    app = app_factory(ROVER_WEB_AUTH="required", ROVER_WEB_DB_PATH=str(db_path))
-    app.tokens = tokens
-    return app
+from tests.support.auth import PASSWORD, sign_in
 
 
 def test_auto_on_loopback_needs_no_sign_in(client):
