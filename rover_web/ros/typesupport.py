@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import re
 from functools import lru_cache
+from pathlib import Path
 
-_TYPE_RE = re.compile(r"^([a-z][a-z0-9_]*)/(?:msg/)?([A-Z][A-Za-z0-9]*)$")
+# \Z, not $: "$" also matches before a trailing newline.
+_TYPE_RE = re.compile(r"([a-z][a-z0-9_]*)/(?:msg/)?([A-Z][A-Za-z0-9]*)\Z")
 
 
 class UnknownMessageType(LookupError):
@@ -16,10 +19,12 @@ class UnknownMessageType(LookupError):
 @lru_cache(maxsize=256)
 def message_class(type_name: str) -> type:
     """Import a message class by name; raise UnknownMessageType with the reason otherwise."""
-    match = _TYPE_RE.match(type_name or "")
+    match = _TYPE_RE.match(type_name) if isinstance(type_name, str) else None
     if not match:
         raise UnknownMessageType(f"{type_name!r} is not a message type name like std_msgs/msg/String")
     package, name = match.groups()
+    if not is_interface_package(package):
+        raise UnknownMessageType(f"{package!r} is not an installed ROS interface package")
     try:
         module = importlib.import_module(f"{package}.msg")
     except ImportError:
@@ -28,6 +33,18 @@ def message_class(type_name: str) -> type:
     if cls is None or not hasattr(cls, "get_fields_and_field_types"):
         raise UnknownMessageType(f"{package} has no message {name!r}") from None
     return cls
+
+
+@lru_cache(maxsize=256)
+def is_interface_package(package: str) -> bool:
+    """True for a package built by rosidl (it ships its C type support beside its Python code),
+    decided without importing it: a type name from a browser must never run an arbitrary
+    module's import-time code (`this`, `antigravity`, anything on sys.path)."""
+    spec = importlib.util.find_spec(package)  # a top-level name: found, not imported
+    if spec is None or not spec.submodule_search_locations:
+        return False
+    return any(any(Path(location).glob(f"{package}_s__rosidl_typesupport_c*"))
+               for location in spec.submodule_search_locations)
 
 
 def type_name(cls_or_msg) -> str:

@@ -140,3 +140,16 @@ def test_bad_echo_requests_get_a_4xx_json_reason(live_server, query, status, cod
 def test_echo_of_a_topic_not_yet_published_waits_for_it_with_a_type(live_server, sse_client):
     stream = sse_client(live_server.url + "/api/topics/echo?topic=/test/later&type=std_msgs/String")
     assert stream.wait_for("stats", timeout=10)["json"]["type"] == "std_msgs/msg/String"
+
+
+@pytest.mark.parametrize("param,path", [("type", "/api/topics/echo?topic=/x&type={}"),
+                                        ("msg_type", "/snapshot?topic=/x&msg_type={}")])
+def test_a_type_name_from_the_query_never_imports_a_python_module(client, param, path):
+    """type=this/msg/X used to import Python's `this` (and antigravity/msg/X to start a browser)."""
+    import sys
+
+    assert "this" not in sys.modules
+    response = client.get(path.format("this/msg/X"))
+    assert 400 <= response.status_code < 500, (param, response.status_code, response.get_data(as_text=True))
+    assert response.is_json and "interface package" in response.get_json()["message"]
+    assert "this" not in sys.modules
