@@ -24,7 +24,7 @@ def message_class(type_name: str) -> type:
         raise UnknownMessageType(f"{type_name!r} is not a message type name like std_msgs/msg/String")
     package, name = match.groups()
     if not is_interface_package(package):
-        raise UnknownMessageType(f"{package!r} is not an installed ROS interface package")
+        raise UnknownMessageType(f"{package!r} is not installed as a ROS interface package")
     try:
         module = importlib.import_module(f"{package}.msg")
     except ImportError:
