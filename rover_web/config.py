@@ -41,7 +41,7 @@ class Setting:
     choices: tuple[str, ...] | None = None
 
 
-TOPIC_PATTERN = re.compile(r"^/?[A-Za-z_~{][A-Za-z0-9_{}~]*(/[A-Za-z_{][A-Za-z0-9_{}]*)*$")
+TOPIC_PATTERN = re.compile(r"/?[A-Za-z_~{][A-Za-z0-9_{}~]*(/[A-Za-z_{][A-Za-z0-9_{}]*)*\Z")
 
 SETTINGS: tuple[Setting, ...] = (
     # --- process and ROS node ---

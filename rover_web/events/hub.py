@@ -18,7 +18,7 @@ from collections import deque
 from collections.abc import Iterable
 from typing import Any
 
-CHANNEL_RE = re.compile(r"^[a-z][a-z0-9_]{0,31}$")
+CHANNEL_RE = re.compile(r"[a-z][a-z0-9_]{0,31}\Z")
 
 
 def encode(data: Any) -> str:

@@ -23,7 +23,7 @@ from typing import Any
 from rover_web.config import TOPIC_PATTERN, ConfigError
 
 DEFAULT_FILE = Path(__file__).with_name("drone.toml")
-ID_RE = re.compile(r"^[a-z][a-z0-9_-]{0,31}$")
+ID_RE = re.compile(r"[a-z][a-z0-9_-]{0,31}\Z")
 # Path segments under /api/panels/<panel>/ that are not controls.
 RESERVED_CONTROL_IDS = frozenset({"unlock", "lock", "log"})
 QOS_NAMES = ("default", "sensor_data", "latched")
@@ -67,7 +67,7 @@ SCALAR_TYPES: dict[str, ScalarType] = {t.name: t for t in (
     ScalarType("std_msgs/msg/String", "string"),
 )}
 
-_TYPE_NAME_RE = re.compile(r"^([a-z][a-z0-9_]*)/(?:msg/)?([A-Z][A-Za-z0-9]*)$")
+_TYPE_NAME_RE = re.compile(r"([a-z][a-z0-9_]*)/(?:msg/)?([A-Z][A-Za-z0-9]*)\Z")
 
 
 def canonical_type(name: str) -> str | None:

@@ -34,7 +34,7 @@ UNKNOWN = "unknown"
 CODE_LENGTH = 3
 # Longest text worth matching against a colour name, and the longest label kept for the page.
 MAX_TEXT_CHARS = 64
-COLOUR_NAME_RE = re.compile(r"^[a-z][a-z0-9_-]{0,31}$")
+COLOUR_NAME_RE = re.compile(r"[a-z][a-z0-9_-]{0,31}\Z")
 
 # Why a cycle produced no code.
 UNKNOWN_COLOUR = "unknown_colour"

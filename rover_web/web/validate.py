@@ -98,7 +98,7 @@ def only_keys(obj: dict, allowed: set[str]) -> None:
                            "unknown_field")
 
 
-_TOPIC_TOKEN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+_TOPIC_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 TOPIC_MAX_LEN = 247  # rmw's limit leaves room for the DDS prefix within 255 characters
 
 
@@ -111,7 +111,10 @@ def topic_name(value: Any, field: str = "topic") -> str:
     """
     if not isinstance(value, str) or not value.strip():
         raise InvalidInput(f"'{field}' is required: a ROS topic name such as /camera/image_raw", "missing_field")
-    name = value.strip()
+    name = value
+    if name != name.strip():
+        # Not trimmed: a name with a newline or space at an end is a mistake (or a probe) to refuse.
+        raise InvalidInput(f"'{field}' {value.strip()[:80]!r} has spaces or line breaks around it", "bad_topic")
     if len(name) > TOPIC_MAX_LEN:
         raise InvalidInput(f"'{field}' is longer than {TOPIC_MAX_LEN} characters", "bad_topic")
     if not name.startswith("/"):

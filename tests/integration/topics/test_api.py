@@ -153,3 +153,10 @@ def test_a_type_name_from_the_query_never_imports_a_python_module(client, param,
     assert 400 <= response.status_code < 500, (param, response.status_code, response.get_data(as_text=True))
     assert response.is_json and "interface package" in response.get_json()["message"]
     assert "this" not in sys.modules
+
+
+@pytest.mark.parametrize("topic", ["/a%0A/b", "/chatter%0A"])
+def test_a_topic_name_with_a_line_break_is_a_400_not_a_500(client, topic):
+    response = client.get(f"/api/topics/echo?topic={topic}&type=std_msgs/msg/String")
+    assert response.status_code == 400, response.get_data(as_text=True)
+    assert response.get_json()["error"] == "bad_topic"

@@ -36,3 +36,40 @@ def test_text_and_only_keys():
         text({"c": "x" * 300}, "c")
     with pytest.raises(InvalidInput, match="unknown field"):
         only_keys({"a": 1, "b": 2}, {"a"})
+
+
+@pytest.mark.parametrize("name", ["/cmd_vel\n", "/a\n/b", "\n/cmd_vel", " /cmd_vel", "/cmd_vel ", "/a\r/b"])
+def test_topic_names_with_line_breaks_or_spaces_are_bad_topics(name):
+    """`$` also matches before a trailing newline: '/a\\n/b' passed the token check and reached rclpy."""
+    from rover_web.web.validate import topic_name
+
+    with pytest.raises(InvalidInput) as caught:
+        topic_name(name)
+    assert caught.value.code == "bad_topic"
+
+
+def test_every_name_pattern_refuses_a_trailing_newline():
+    """Each pattern that accepts a name must refuse that name with a newline after it."""
+    from rover_web.config import TOPIC_PATTERN
+    from rover_web.events.hub import CHANNEL_RE
+    from rover_web.panels.spec import _TYPE_NAME_RE, ID_RE
+    from rover_web.scan_the_code.light_sequence import COLOUR_NAME_RE
+
+    for pattern, good in [(TOPIC_PATTERN, "/cmd_vel"), (CHANNEL_RE, "telemetry"), (ID_RE, "drone"),
+                          (_TYPE_NAME_RE, "std_msgs/msg/Int8"), (COLOUR_NAME_RE, "red")]:
+        assert pattern.match(good), pattern.pattern
+        assert not pattern.match(good + "\n"), pattern.pattern
+
+
+def test_no_pattern_in_the_code_ends_with_a_dollar():
+    """The slip, found once, kept out: a regex literal ending in `$` inside rover_web/."""
+    import re
+    from pathlib import Path
+
+    import rover_web
+
+    literal = re.compile(r"""re\.compile\(\s*r?["'](?P<body>.*?)["']\s*[,)]""")
+    offenders = [f"{path.name}: {m['body']}"
+                 for path in Path(rover_web.__file__).parent.rglob("*.py")
+                 for m in literal.finditer(path.read_text()) if m["body"].endswith("$")]
+    assert offenders == []
