@@ -168,6 +168,9 @@ def is_jpeg(data) -> bool:
     return head == b"\xff\xd8\xff"
 
 
+IMAGE_FORMATS = ("JPEG", "PNG")
+
+
 def encode_compressed(frame: CompressedFrame, quality: int, width: int | None = None,
                       height: int | None = None) -> Jpeg:
     """A sensor_msgs/CompressedImage as JPEG: passed through if it is one and no size is asked."""
@@ -182,7 +185,9 @@ def encode_compressed(frame: CompressedFrame, quality: int, width: int | None = 
             return Jpeg(data, size[0], size[1], frame.stamp, passthrough=True,
                         encode_s=time.perf_counter() - started)
     try:
-        picture = Image.open(io.BytesIO(data))
+        # Only the two formats a camera sends: Pillow would otherwise also parse EPS (through
+        # Ghostscript), TIFF, ICO and dozens more from bytes any publisher on the graph chooses.
+        picture = Image.open(io.BytesIO(data), formats=IMAGE_FORMATS)
         if picture.width * picture.height > MAX_PIXELS:
             raise FrameError(f"image is {picture.width}×{picture.height}, more than {MAX_PIXELS} pixels",
                              "image_too_large")
@@ -206,7 +211,7 @@ def encode_compressed(frame: CompressedFrame, quality: int, width: int | None = 
 def _jpeg_size(data: bytes) -> tuple[int, int]:
     """Width and height from the JPEG's start-of-frame header, without decoding it."""
     try:
-        with Image.open(io.BytesIO(data)) as picture:
+        with Image.open(io.BytesIO(data), formats=("JPEG",)) as picture:
             return picture.size
     except Exception:
         return 0, 0

@@ -38,6 +38,7 @@ from rover_web.config import ROOT, ConfigError
 from .geometry import MapGeometry, wrap_angle
 
 IMAGE_SUFFIXES = (".png", ".pgm")
+MAP_IMAGE_FORMATS = ("PNG", "PPM")  # Pillow reads PGM as its PPM format; nothing else is opened
 MAX_IMAGE_SIDE_PX = 8192
 THUMBNAIL_SIDE_PX = 320
 MAX_NAME_CHARS = 80
@@ -97,7 +98,7 @@ class MapDefinition:
 
 
 def make_thumbnail(png: bytes, side_px: int = THUMBNAIL_SIDE_PX) -> bytes:
-    with Image.open(io.BytesIO(png)) as image:
+    with Image.open(io.BytesIO(png), formats=("PNG",)) as image:
         image = image.convert("RGBA" if "A" in image.getbands() else "RGB")
         image.thumbnail((side_px, side_px), Image.Resampling.BOX)  # BOX keeps thin walls visible as grey
         out = io.BytesIO()
@@ -110,7 +111,7 @@ def _display_png(path: Path, params: dict) -> bytes:
     negate = bool(params.get("negate", 0))
     if path.suffix.lower() == ".png" and not negate:
         return path.read_bytes()
-    with Image.open(path) as image:
+    with Image.open(path, formats=MAP_IMAGE_FORMATS) as image:
         image.load()
         if negate:
             if image.mode in ("LA", "RGBA"):
@@ -217,7 +218,7 @@ def _image_size(path: Path, src: _Source, key: str) -> tuple[int, int]:
     if not path.is_file():
         raise src.error(key, f"{path} not found")
     try:
-        with Image.open(path) as image:
+        with Image.open(path, formats=MAP_IMAGE_FORMATS) as image:
             size = image.size
             if max(size) > MAX_IMAGE_SIDE_PX:
                 raise src.error(key, f"{path.name} is {size[0]}x{size[1]} px; at most {MAX_IMAGE_SIDE_PX} a side")

@@ -190,3 +190,22 @@ def test_bad_compressed_frames(frame, code):
 def test_error_frame_is_a_jpeg_of_the_asked_size():
     jpeg = error_frame("image encoding 'yuv422' is not supported", "unsupported_encoding", width=320)
     assert decode(jpeg.data).size == (320, 180) and jpeg.error.startswith("image encoding")
+
+
+EPS = (b"%!PS-Adobe-3.0 EPSF-3.0\n%%BoundingBox: 0 0 8 8\nnewpath 0 0 moveto 8 8 lineto stroke\n"
+       b"showpage\n%%EOF\n")
+
+
+@pytest.mark.parametrize("fmt", ["BMP", "GIF", "TIFF", "ICO", "EPS"])
+def test_compressed_images_are_decoded_only_as_jpeg_or_png(fmt):
+    """A publisher's bytes never reach Pillow's other decoders (EPS runs Ghostscript)."""
+    if fmt == "EPS":
+        data = EPS
+    else:
+        out = io.BytesIO()
+        Image.new("RGB", (W, H), LEFT).save(out, fmt)
+        data = out.getvalue()
+    with pytest.raises(FrameError) as info:
+        encode_compressed(CompressedFrame("jpeg", data), 80)
+    assert info.value.code == "bad_image"
+

@@ -153,6 +153,12 @@ def test_a_corrupt_image_fails_at_start(folder):
     expect_error(write_catalog(folder, {"Hall": campus_entry()}), "png_file.file_name", "not a readable image")
 
 
+@pytest.mark.parametrize("fmt", ["BMP", "GIF", "TIFF"])
+def test_a_floorplan_is_read_only_as_png_or_pgm_whatever_its_name(folder, fmt):
+    Image.new("L", (40, 20), 254).save(folder / "m" / "m.png", fmt)  # another format under a .png name
+    expect_error(write_catalog(folder, {"Hall": campus_entry()}), "png_file.file_name", "not a readable image")
+
+
 @pytest.mark.parametrize("waypoints, words", [
     ([{"name": "Far", "x": 100.0, "y": 3.0}], ["w.json", "waypoints[0]", "outside the map"]),
     ([{"name": "A", "x": 2.0, "y": 3.0}, {"name": "A", "x": 3.0, "y": 3.0}], ["waypoints[1].name", "duplicate"]),
