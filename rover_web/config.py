@@ -168,6 +168,12 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("CAMERA_MAX_VIEWERS", 24, "int",
             "most /stream and /snapshot requests served at once (503 beyond); each holds a server thread", 1, 1024),
     Setting("CAMERA_SNAPSHOT_TIMEOUT_S", 5.0, "float", "how long /snapshot waits for a frame", 0.1, 60),
+    Setting("CAMERA_MAX_PRODUCERS", 8, "int",
+            "most different streams (topic, size, quality, QoS) encoded at once; viewers of the same one "
+            "share it (503 beyond)", 1, 256),
+    Setting("CAMERA_MAX_OUTPUT_PIXELS", 3840 * 2160, "int",
+            "largest width × height a stream is encoded at (a larger asked size is refused, a derived one "
+            "scaled down)", 256, 64 * 1024 * 1024),
     # --- topic browser ---
     Setting("TOPICS_REFRESH_S", 1.0, "float",
             "how often the topic list (`topics` channel) is re-read from the ROS graph",
@@ -177,6 +183,9 @@ SETTINGS: tuple[Setting, ...] = (
             "arrays and byte fields longer than this are shown cut, with their length", 1, 10000),
     Setting("TOPICS_ECHO_IDLE_TIMEOUT_S", 2.0, "float",
             "how long a topic browser subscription stays after its last viewer leaves", 0.0, 600),
+    Setting("TOPICS_ECHO_MAX_SUBSCRIPTIONS", 16, "int",
+            "most different topics (and types) echoed at once; viewers of the same one share it (503 beyond)",
+            1, 1024),
     # --- scan the code ---
     Setting("LIGHT_SEQUENCE_TOPIC", "/light_sequence", "topic",
             "std_msgs/String colour names from the light tower detector (Scan the Code)"),

@@ -20,6 +20,7 @@ Choices an operator may want to know:
 from __future__ import annotations
 
 import io
+import math
 import time
 from dataclasses import dataclass
 
@@ -135,20 +136,27 @@ def stretch_to_8bit(values: np.ndarray, valid: np.ndarray) -> np.ndarray:
     return out
 
 
-def output_size(src_width: int, src_height: int, width: int | None, height: int | None) -> tuple[int, int]:
-    """The size to send: as asked, or keeping the aspect ratio when only one side is given."""
+def output_size(src_width: int, src_height: int, width: int | None, height: int | None,
+                max_pixels: int | None = None) -> tuple[int, int]:
+    """The size to send: as asked, or keeping the aspect ratio when only one side is given; scaled
+    down to `max_pixels` (one side of a tall or wide source would otherwise ask for a huge image)."""
     if width and height:
-        return width, height
-    if width:
-        return width, max(1, round(src_height * width / src_width))
-    if height:
-        return max(1, round(src_width * height / src_height)), height
-    return src_width, src_height
+        size = width, height
+    elif width:
+        size = width, max(1, round(src_height * width / src_width))
+    elif height:
+        size = max(1, round(src_width * height / src_height)), height
+    else:
+        size = src_width, src_height
+    if max_pixels and size[0] * size[1] > max_pixels:
+        scale = math.sqrt(max_pixels / (size[0] * size[1]))
+        size = max(1, int(size[0] * scale)), max(1, int(size[1] * scale))
+    return size
 
 
 def _encode_picture(picture: Image.Image, quality: int, width: int | None, height: int | None, stamp: float,
-                    started: float) -> Jpeg:
-    size = output_size(picture.width, picture.height, width, height)
+                    started: float, max_pixels: int | None) -> Jpeg:
+    size = output_size(picture.width, picture.height, width, height, max_pixels)
     if size != picture.size:
         picture = picture.resize(size, Image.Resampling.BILINEAR)
     out = io.BytesIO()
@@ -156,11 +164,12 @@ def _encode_picture(picture: Image.Image, quality: int, width: int | None, heigh
     return Jpeg(out.getvalue(), size[0], size[1], stamp, encode_s=time.perf_counter() - started)
 
 
-def encode_raw(image: RawImage, quality: int, width: int | None = None, height: int | None = None) -> Jpeg:
+def encode_raw(image: RawImage, quality: int, width: int | None = None, height: int | None = None,
+               max_pixels: int | None = None) -> Jpeg:
     """A sensor_msgs/Image as JPEG; FrameError for encodings or layouts that cannot be shown."""
     started = time.perf_counter()
     picture = Image.fromarray(np.ascontiguousarray(image_to_array(image)))
-    return _encode_picture(picture, quality, width, height, image.stamp, started)
+    return _encode_picture(picture, quality, width, height, image.stamp, started, max_pixels)
 
 
 def is_jpeg(data) -> bool:
@@ -172,7 +181,7 @@ IMAGE_FORMATS = ("JPEG", "PNG")
 
 
 def encode_compressed(frame: CompressedFrame, quality: int, width: int | None = None,
-                      height: int | None = None) -> Jpeg:
+                      height: int | None = None, max_pixels: int | None = None) -> Jpeg:
     """A sensor_msgs/CompressedImage as JPEG: passed through if it is one and no size is asked."""
     started = time.perf_counter()
     if "compresseddepth" in frame.format.lower():
@@ -181,7 +190,7 @@ def encode_compressed(frame: CompressedFrame, quality: int, width: int | None = 
     data = bytes(frame.data)
     if is_jpeg(data):
         size = _jpeg_size(data)
-        if size != (0, 0) and output_size(size[0], size[1], width, height) == size:
+        if size != (0, 0) and output_size(size[0], size[1], width, height, max_pixels) == size:
             return Jpeg(data, size[0], size[1], frame.stamp, passthrough=True,
                         encode_s=time.perf_counter() - started)
     try:
@@ -193,7 +202,7 @@ def encode_compressed(frame: CompressedFrame, quality: int, width: int | None = 
                              "image_too_large")
         if picture.format == "JPEG":
             # Let libjpeg scale by 1/2, 1/4 or 1/8 while decoding when the output is smaller.
-            picture.draft("RGB", output_size(picture.width, picture.height, width, height))
+            picture.draft("RGB", output_size(picture.width, picture.height, width, height, max_pixels))
         picture.load()
     except FrameError:
         raise
@@ -205,7 +214,7 @@ def encode_compressed(frame: CompressedFrame, quality: int, width: int | None = 
         picture = Image.fromarray(stretch_to_8bit(values, valid))
     elif picture.mode not in ("RGB", "L"):
         picture = picture.convert("RGB")
-    return _encode_picture(picture, quality, width, height, frame.stamp, started)
+    return _encode_picture(picture, quality, width, height, frame.stamp, started, max_pixels)
 
 
 def _jpeg_size(data: bytes) -> tuple[int, int]:
@@ -230,9 +239,9 @@ def font(size: int):
 
 
 def error_frame(message: str, code: str, width: int | None = None, height: int | None = None,
-                stamp: float = 0.0) -> Jpeg:
+                stamp: float = 0.0, max_pixels: int | None = None) -> Jpeg:
     """A dark JPEG with the reason written on it, for a stream that has already started."""
-    size = output_size(640, 360, width, height)
+    size = output_size(640, 360, width, height, max_pixels)
     picture = Image.new("RGB", size, (40, 12, 12))
     draw = ImageDraw.Draw(picture)
     text_size = max(10, min(22, size[0] // 32))
@@ -254,11 +263,11 @@ def error_frame(message: str, code: str, width: int | None = None, height: int |
 
 
 def encode_frame(frame: RawImage | CompressedFrame, quality: int, width: int | None = None,
-                 height: int | None = None) -> Jpeg:
+                 height: int | None = None, max_pixels: int | None = None) -> Jpeg:
     """Any frame as JPEG; a frame that cannot be shown becomes an error frame saying why."""
     try:
         if isinstance(frame, CompressedFrame):
-            return encode_compressed(frame, quality, width, height)
-        return encode_raw(frame, quality, width, height)
+            return encode_compressed(frame, quality, width, height, max_pixels)
+        return encode_raw(frame, quality, width, height, max_pixels)
     except FrameError as exc:
-        return error_frame(str(exc), exc.code, width, height, getattr(frame, "stamp", 0.0))
+        return error_frame(str(exc), exc.code, width, height, getattr(frame, "stamp", 0.0), max_pixels)

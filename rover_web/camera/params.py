@@ -27,11 +27,15 @@ def _int_arg(args: Mapping[str, str], name: str, low: int, high: int, *, origina
     return value
 
 
-def parse_stream_args(args: Mapping[str, str], *, max_dimension: int, default_quality: int) -> dict:
+def parse_stream_args(args: Mapping[str, str], *, max_dimension: int, default_quality: int,
+                      max_pixels: int | None = None) -> dict:
     """Check a /stream or /snapshot query; the message type and QoS may still be left to the graph."""
     topic = topic_name(args.get("topic"))
     width = _int_arg(args, "width", 1, max_dimension, original_ok=True)
     height = _int_arg(args, "height", 1, max_dimension, original_ok=True)
+    if max_pixels and width and height and width * height > max_pixels:
+        raise InvalidInput(f"{width}×{height} is more than {max_pixels} pixels (ROVER_WEB_CAMERA_MAX_OUTPUT_PIXELS); "
+                           f"ask for a smaller size, or one side only", "out_of_range")
     quality = _int_arg(args, "quality", 1, 100)
     qos = args.get("qos_profile") or None
     if qos is not None and qos not in QOS_PROFILES:

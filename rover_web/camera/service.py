@@ -6,7 +6,7 @@ import logging
 import threading
 from collections.abc import Mapping
 
-from rover_web.core.leases import Closed, Leases
+from rover_web.core.leases import Closed, Full, Leases
 from rover_web.core.state import Rover
 from rover_web.ros.graph import publishers_best_effort, topic_types
 from rover_web.ros.typesupport import UnknownMessageType, message_class
@@ -50,8 +50,10 @@ class CameraStreams:
         self.default_quality = config["ROVER_WEB_CAMERA_QUALITY"]
         self.max_viewers = config["ROVER_WEB_CAMERA_MAX_VIEWERS"]
         self.snapshot_timeout_s = config["ROVER_WEB_CAMERA_SNAPSHOT_TIMEOUT_S"]
+        self.max_output_pixels = config["ROVER_WEB_CAMERA_MAX_OUTPUT_PIXELS"]
         self.producers: Leases[FrameProducer] = Leases(self._open, self._close,
-                                                       config["ROVER_WEB_CAMERA_IDLE_TIMEOUT_S"])
+                                                       config["ROVER_WEB_CAMERA_IDLE_TIMEOUT_S"],
+                                                       max_keys=config["ROVER_WEB_CAMERA_MAX_PRODUCERS"])
         self._viewers = 0
         self._lock = threading.Lock()
 
@@ -69,14 +71,13 @@ class CameraStreams:
         if self.rover.runtime.running:  # after runtime.stop the node and its subscriptions are gone
             self.rover.runtime.destroy(producer.subscription)
 
-    @staticmethod
-    def _encode(key: StreamKey, raw) -> imaging.Jpeg:
+    def _encode(self, key: StreamKey, raw) -> imaging.Jpeg:
         try:
-            return imaging.encode_frame(raw, key.quality, key.width, key.height)
+            return imaging.encode_frame(raw, key.quality, key.width, key.height, self.max_output_pixels)
         except Exception:  # a bug, not bad data: keep the stream alive and say where to look
             log.exception("encoding a frame from %s failed", key.topic)
             return imaging.error_frame("the server could not encode this frame; see its log", "internal_error",
-                                       key.width, key.height)
+                                       key.width, key.height, max_pixels=self.max_output_pixels)
 
     # --- requests ---
 
@@ -85,7 +86,8 @@ class CameraStreams:
 
         InvalidInput for a bad query, UnknownTopic for a topic the graph does not know (and no type given).
         """
-        parsed = parse_stream_args(args, max_dimension=self.max_dimension, default_quality=self.default_quality)
+        parsed = parse_stream_args(args, max_dimension=self.max_dimension, default_quality=self.default_quality,
+                                   max_pixels=self.max_output_pixels)
         topic = parsed["topic"]
         runtime = self.rover.runtime
         known = topic_types(runtime).get(topic)
@@ -119,6 +121,11 @@ class CameraStreams:
         except Closed:
             self._viewer_left()
             raise Unavailable("the server is shutting down", "shutting_down") from None
+        except Full:
+            self._viewer_left()
+            raise Unavailable(f"{len(self.producers)} different camera streams are being encoded already "
+                              f"(ROVER_WEB_CAMERA_MAX_PRODUCERS); view one of them, or try again when one ends",
+                              "too_many_producers") from None
         except Exception as exc:
             self._viewer_left()
             log.exception("cannot subscribe to %s", key.topic)

@@ -22,6 +22,10 @@ class Closed(RuntimeError):
     """The registry is shutting down: no new users."""
 
 
+class Full(RuntimeError):
+    """`max_keys` different resources are in use: a new one would pass the cap."""
+
+
 class _Entry(Generic[T]):
     __slots__ = ("value", "users", "idle_since")
 
@@ -35,9 +39,10 @@ class Leases(Generic[T]):
     """key -> resource, made by `open(key)` on first use and closed by `close(resource)` when idle."""
 
     def __init__(self, open: Callable[[Hashable], T], close: Callable[[T], None], linger_s: float,
-                 clock: Callable[[], float] = time.monotonic):
+                 clock: Callable[[], float] = time.monotonic, max_keys: int | None = None):
         self._open, self._close = open, close
         self.linger_s = linger_s
+        self.max_keys = max_keys
         self._clock = clock
         self._entries: dict[Hashable, _Entry[T]] = {}
         self._cond = threading.Condition()
@@ -45,17 +50,35 @@ class Leases(Generic[T]):
         self._reaper: threading.Thread | None = None
 
     def acquire(self, key: Hashable) -> T:
-        """The resource for `key`, opened now if nobody holds it; exceptions from open propagate."""
-        with self._cond:
-            if self._closed:
-                raise Closed("shutting down")
-            entry = self._entries.get(key)
-            if entry is None:
-                # Opened under the lock so two first viewers cannot both create a subscription.
-                entry = self._entries[key] = _Entry(self._open(key))
-            entry.users += 1
-            entry.idle_since = None
-            return entry.value
+        """The resource for `key`, opened now if nobody holds it; exceptions from open propagate.
+        Full when `max_keys` resources are all in use."""
+        evicted = None
+        try:
+            with self._cond:
+                if self._closed:
+                    raise Closed("shutting down")
+                entry = self._entries.get(key)
+                if entry is None:
+                    evicted = self._make_room()
+                    # Opened under the lock so two first viewers cannot both create a subscription.
+                    entry = self._entries[key] = _Entry(self._open(key))
+                entry.users += 1
+                entry.idle_since = None
+                return entry.value
+        finally:
+            if evicted is not None:  # closed outside the lock, and even when opening the new one failed
+                self._safe_close(*evicted)
+
+    def _make_room(self) -> tuple[Hashable, T] | None:
+        """At the cap, the longest-idle resource goes now rather than after its linger: a lingering
+        one only saves a re-subscription, while a refused viewer gets nothing. Called locked."""
+        if self.max_keys is None or len(self._entries) < self.max_keys:
+            return None
+        idle = [(e.idle_since, k) for k, e in self._entries.items() if e.users == 0 and e.idle_since is not None]
+        if not idle:
+            raise Full(f"{len(self._entries)} in use already")
+        _, key = min(idle, key=lambda pair: pair[0])
+        return key, self._entries.pop(key).value
 
     def release(self, key: Hashable) -> None:
         with self._cond:

@@ -6,7 +6,7 @@ import logging
 import threading
 from collections.abc import Mapping
 
-from rover_web.core.leases import Closed, Leases
+from rover_web.core.leases import Closed, Full, Leases
 from rover_web.core.state import Rover
 from rover_web.ros import graph
 from rover_web.ros.typesupport import UnknownMessageType, message_class
@@ -55,7 +55,8 @@ class TopicBrowser:
         self.echo_hz = config["ROVER_WEB_TOPICS_ECHO_HZ"]
         self.max_items = config["ROVER_WEB_TOPICS_ECHO_MAX_ITEMS"]
         self.max_viewers = config["ROVER_WEB_SSE_MAX_CLIENTS"]
-        self.echoes: Leases[TopicEcho] = Leases(self._open, self._close, config["ROVER_WEB_TOPICS_ECHO_IDLE_TIMEOUT_S"])
+        self.echoes: Leases[TopicEcho] = Leases(self._open, self._close, config["ROVER_WEB_TOPICS_ECHO_IDLE_TIMEOUT_S"],
+                                                max_keys=config["ROVER_WEB_TOPICS_ECHO_MAX_SUBSCRIPTIONS"])
         self._viewers = 0
         self._lock = threading.Lock()
         self._published: dict | None = None  # only the refresh loop touches it
@@ -122,6 +123,11 @@ class TopicBrowser:
         except Closed:
             self._viewer_left()
             raise Unavailable("the server is shutting down", "shutting_down") from None
+        except Full:
+            self._viewer_left()
+            raise Unavailable(f"{len(self.echoes)} different topics are being echoed already "
+                              f"(ROVER_WEB_TOPICS_ECHO_MAX_SUBSCRIPTIONS); try again when one closes",
+                              "too_many_subscriptions") from None
         except Exception as exc:
             self._viewer_left()
             log.exception("cannot subscribe to %s", key[0])

@@ -282,3 +282,30 @@ def test_viewer_limit(live_server_factory, mjpeg_client):
     response = requests.get(server.url + "/stream", params={"topic": "/test_cam/nobody", "msg_type": IMAGE},
                             timeout=10)
     assert response.status_code == 503 and response.json()["error"] == "too_many_viewers"
+
+
+def test_different_camera_streams_count_toward_a_cap_and_an_idle_one_makes_room(live_server_factory, mjpeg_client):
+    """Every (topic, size, quality, QoS) is its own subscription and encoder: a query string must
+    not make them without bound."""
+    server = live_server_factory(ROVER_WEB_CAMERA_MAX_PRODUCERS=2, ROVER_WEB_CAMERA_IDLE_TIMEOUT_S=600)
+    url = f"{server.url}/stream?topic=/test_cam/nobody&msg_type={IMAGE}&width="
+    first = mjpeg_client(url + "100")
+    second = mjpeg_client(url + "200")
+    wait_until(lambda: first.status == 200 and second.status == 200, 10, "two streams open")
+    refused = requests.get(url + "300", timeout=10)
+    assert refused.status_code == 503 and refused.json()["error"] == "too_many_producers"
+    assert len(streams(server).producers) == 2
+    first.close()
+    wait_until(lambda: streams(server).viewers == 1, 10, "first viewer released")
+    third = mjpeg_client(url + "300")  # the idle 100-wide one goes now, not in 600 s
+    wait_until(lambda: third.status == 200, 10, "third stream open")
+    assert sorted(key.width for key, _, _ in streams(server).producers.items()) == [200, 300]
+
+
+def test_an_asked_size_beyond_the_output_area_is_refused(live_server_factory):
+    server = live_server_factory(ROVER_WEB_CAMERA_MAX_OUTPUT_PIXELS=1_000_000)
+    response = requests.get(server.url + "/snapshot", timeout=10,
+                            params={"topic": "/x", "msg_type": IMAGE, "width": "2000", "height": "1000"})
+    assert response.status_code == 400 and response.json()["error"] == "out_of_range"
+    assert "ROVER_WEB_CAMERA_MAX_OUTPUT_PIXELS" in response.json()["message"]
+    assert len(streams(server).producers) == 0

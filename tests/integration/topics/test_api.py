@@ -160,3 +160,28 @@ def test_a_topic_name_with_a_line_break_is_a_400_not_a_500(client, topic):
     response = client.get(f"/api/topics/echo?topic={topic}&type=std_msgs/msg/String")
     assert response.status_code == 400, response.get_data(as_text=True)
     assert response.get_json()["error"] == "bad_topic"
+
+
+def test_different_echoes_count_toward_a_cap_and_an_idle_one_makes_room_at_once(live_server_factory, sse_client):
+    """Each echo query makes a ROS subscription: a client asking for many topics must not make
+    unbounded subscriptions. Beyond the cap a 503; an idle one (lingering) goes at once for a new one."""
+    server = live_server_factory(ROVER_WEB_TOPICS_ECHO_MAX_SUBSCRIPTIONS=2, ROVER_WEB_TOPICS_ECHO_IDLE_TIMEOUT_S=600)
+    url = server.url + "/api/topics/echo?type=std_msgs/msg/String&topic="
+    first = sse_client(url + "/test/cap_a")
+    sse_client(url + "/test/cap_b").wait_for("stats", timeout=10)
+    first.wait_for("stats", timeout=10)
+    refused = requests.get(url + "/test/cap_c", timeout=5)
+    assert refused.status_code == 503 and refused.json()["error"] == "too_many_subscriptions"
+    assert len(echoes(server)) == 2
+    again = sse_client(url + "/test/cap_a")  # sharing an open one is never refused
+    again.wait_for("stats", timeout=10)
+    assert len(echoes(server)) == 2
+    key_a = ("/test/cap_a", "std_msgs/msg/String")
+    first.close()
+    wait_until(lambda: echoes(server).users(key_a) == 1, 10, "first viewer left")
+    assert requests.get(url + "/test/cap_c", timeout=5).status_code == 503  # both still watched
+    again.close()
+    wait_until(lambda: echoes(server).users(key_a) == 0, 10, "last viewer of /test/cap_a left")
+    # Lingering for 600 s, yet it makes room at once: a lingering one only saves a re-subscription.
+    sse_client(url + "/test/cap_c").wait_for("stats", timeout=10)
+    assert key_a not in echoes(server) and len(echoes(server)) == 2

@@ -111,6 +111,18 @@ def test_resize_exact_and_by_aspect_ratio():
     assert output_size(640, 480, None, None) == (640, 480)
 
 
+def test_a_derived_size_is_scaled_down_to_the_output_area():
+    """width=4096 of a 4×16384 source would otherwise be a 4096×16777216 image."""
+    w, h = output_size(4, 16384, 4096, None, max_pixels=1_000_000)
+    assert w * h <= 1_000_000 and abs(h / w / 4096 - 1) < 0.1  # the aspect ratio is kept (to a pixel)
+    assert output_size(8000, 8000, None, None, max_pixels=1_000_000) == (1000, 1000)
+    assert output_size(640, 480, None, None, max_pixels=1_000_000) == (640, 480)
+    step, data = two_halves(lambda c: c, 3)
+    tall = RawImage(W, H, "rgb8", step, False, data)
+    w, h = decode(encode_raw(tall, 80, height=3200, max_pixels=100_000).data).size
+    assert w * h <= 100_000 and abs(w / h - W / H) < 0.05
+
+
 def test_quality_changes_the_size():
     rng = np.random.default_rng(1)
     data = rng.integers(0, 255, (H, W, 3), dtype=np.uint8).tobytes()

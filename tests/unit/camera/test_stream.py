@@ -10,7 +10,7 @@ from rover_web.camera.imaging import Jpeg
 from rover_web.camera.mjpeg import multipart_part
 from rover_web.camera.params import parse_stream_args
 from rover_web.camera.stream import FrameProducer, StreamClosed, StreamKey
-from rover_web.core.leases import Closed, Leases
+from rover_web.core.leases import Closed, Full, Leases
 from rover_web.web.validate import InvalidInput
 
 KEY = StreamKey("/cam", "sensor_msgs/msg/Image", "default", None, None, 80)
@@ -127,7 +127,7 @@ class FakeClock:
         return self.now
 
 
-def make_leases(linger_s=2.0):
+def make_leases(linger_s=2.0, max_keys=None):
     opened, closed = [], []
     clock = FakeClock()
 
@@ -135,7 +135,7 @@ def make_leases(linger_s=2.0):
         opened.append(key)
         return f"sub:{key}:{len(opened)}"
 
-    leases = Leases(open_, closed.append, linger_s, clock=clock)
+    leases = Leases(open_, closed.append, linger_s, clock=clock, max_keys=max_keys)
     return leases, opened, closed, clock
 
 
@@ -177,6 +177,43 @@ def test_an_open_that_fails_leaves_nothing_behind():
     with pytest.raises(RuntimeError):
         leases.acquire("a")
     assert len(leases) == 0
+
+
+def test_at_the_cap_a_new_key_is_refused_while_every_resource_is_in_use():
+    leases, opened, closed, _ = make_leases(max_keys=2)
+    leases.acquire("a")
+    leases.acquire("b")
+    with pytest.raises(Full):
+        leases.acquire("c")
+    assert opened == ["a", "b"] and len(leases) == 2 and closed == []
+    assert leases.acquire("a") == "sub:a:1"  # sharing an open one costs nothing and is never refused
+
+
+def test_at_the_cap_the_longest_idle_resource_makes_room_at_once():
+    leases, opened, closed, clock = make_leases(linger_s=60.0, max_keys=2)
+    leases.acquire("a")
+    leases.acquire("b")
+    leases.release("b")
+    clock.now += 1
+    leases.release("a")
+    assert leases.acquire("c") == "sub:c:3"
+    assert closed == ["sub:b:2"] and "a" in leases and "b" not in leases
+
+
+def test_an_evicted_resource_is_closed_even_when_the_new_one_fails_to_open():
+    closed = []
+
+    def open_(key):
+        if key == "bad":
+            raise RuntimeError("no such topic")
+        return key
+
+    leases = Leases(open_, closed.append, 60.0, max_keys=1)
+    leases.acquire("a")
+    leases.release("a")
+    with pytest.raises(RuntimeError):
+        leases.acquire("bad")
+    assert closed == ["a"] and len(leases) == 0
 
 
 def test_reaper_thread_closes_on_time_and_close_all_stops_everything():

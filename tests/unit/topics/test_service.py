@@ -5,7 +5,8 @@ from types import SimpleNamespace
 from rover_web.topics.service import TopicBrowser
 
 CONFIG = {"ROVER_WEB_TOPICS_REFRESH_S": 2.0, "ROVER_WEB_TOPICS_ECHO_HZ": 4.0, "ROVER_WEB_TOPICS_ECHO_MAX_ITEMS": 32,
-          "ROVER_WEB_SSE_MAX_CLIENTS": 8, "ROVER_WEB_TOPICS_ECHO_IDLE_TIMEOUT_S": 5.0}
+          "ROVER_WEB_SSE_MAX_CLIENTS": 8, "ROVER_WEB_TOPICS_ECHO_IDLE_TIMEOUT_S": 5.0,
+          "ROVER_WEB_TOPICS_ECHO_MAX_SUBSCRIPTIONS": 16}
 
 
 class FakeNode:

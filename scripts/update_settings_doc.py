@@ -1,11 +1,11 @@
-"""Rewrite the settings table in README.md from rover_web/config.py."""
+"""Rewrite the settings table in docs/configuration.md from rover_web/config.py."""
 
 import subprocess
 import sys
 from pathlib import Path
 
 root = Path(__file__).resolve().parent.parent
-readme = root / "README.md"
+readme = root / "docs" / "configuration.md"
 table = subprocess.run([sys.executable, str(root / "scripts" / "settings_table.py")], check=True,
                        capture_output=True, text=True).stdout
 text = readme.read_text()
