@@ -89,12 +89,16 @@ class FrameParser:
       ("close", (code, reason))           code 1005 when the frame had none
 
     A message whose size (declared in a frame header, so before its payload is buffered) would
-    pass `max_message_bytes` raises ProtocolError 1009; anything else the RFC forbids, 1002, and
-    text that is not UTF-8, 1007. After an error or a close the parser must not be fed again.
+    pass `max_message_bytes`, or that comes in more than `max_fragments` frames, raises
+    ProtocolError 1009; anything else the RFC forbids, 1002, and text that is not UTF-8, 1007.
+    After an error or a close the parser must not be fed again.
     """
 
-    def __init__(self, max_message_bytes: int):
+    def __init__(self, max_message_bytes: int, max_fragments: int = 64):
         self.max_message_bytes = max_message_bytes
+        # Bytes alone do not bound a message: empty fragments cost nothing against them, yet each
+        # one is kept and handled. A browser sends a teleop message in one frame.
+        self.max_fragments = max_fragments
         # Bytes of a frame still arriving. A bytearray: a big frame trickled in a byte at a time
         # must cost appends, not a copy of everything so far for every byte.
         self._buffer = bytearray()
@@ -168,6 +172,8 @@ class FrameParser:
         if opcode == OP_CONTINUATION:
             if self._fragments is None:
                 raise ProtocolError(CLOSE_PROTOCOL_ERROR, "a continuation frame with no message to continue")
+            if len(self._fragments) >= self.max_fragments:
+                raise ProtocolError(CLOSE_MESSAGE_TOO_BIG, f"a message may come in at most {self.max_fragments} frames")
             size += self._fragment_bytes
         elif opcode in (OP_TEXT, OP_BINARY):
             if self._fragments is not None:

@@ -160,6 +160,19 @@ def test_huge_or_broken_frames_close_the_socket_and_stop(rig, frame, code):
     again.close()
 
 
+def test_a_message_in_endless_empty_fragments_closes_1009_and_stops(rig):
+    """Empty fragments add no bytes, so only a count bounds them."""
+    from tests.support import ws_wire
+
+    server, peer = rig()
+    client = TeleopClient(server.url)
+    client.drive(0.5, 0.0)
+    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == 2.5, timeout=2.0)
+    client.ws.sock.sendall(ws_wire.masked(0x01, b"") + ws_wire.masked(0x00, b"") * 1000)
+    assert client.wait_closed() == 1009
+    peer.wait_for("/cmd_vel", is_zero, timeout=1.0)
+
+
 def test_cross_origin_handshake_is_refused(live_server):
     with pytest.raises(websocket.WebSocketBadStatusException) as info:
         TeleopClient(live_server.url, origin="http://evil.example")

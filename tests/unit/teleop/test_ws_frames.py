@@ -201,6 +201,19 @@ def test_fragments_count_together_against_the_limit():
     assert FrameParser(max_message_bytes=100).feed(masked(0x81, b"x" * 100)) == [("text", "x" * 100)]
 
 
+@pytest.mark.parametrize("payload", [b"", b"x"])
+def test_a_message_in_too_many_fragments_fails_1009_even_when_they_are_empty(payload):
+    """Empty fragments add nothing to a message's bytes: without a count, one socket could send
+    them for ever and the server would keep every one."""
+    parser = FrameParser(max_message_bytes=4096, max_fragments=64)
+    parser.feed(masked(0x01, payload) + masked(0x00, payload) * 63)  # 64 frames, none final: allowed so far
+    with pytest.raises(ProtocolError) as exc:
+        parser.feed(masked(0x00, payload))
+    assert exc.value.close_code == CLOSE_MESSAGE_TOO_BIG and "64 frames" in str(exc.value)
+    whole = FrameParser(max_message_bytes=4096, max_fragments=64)
+    assert whole.feed(masked(0x01, b"a") + masked(0x00, b"") * 62 + masked(0x80, b"b")) == [("text", "ab")]
+
+
 def test_frames_arriving_a_byte_at_a_time_come_out_whole_and_in_order():
     stream = masked(0x81, b'{"linear": 0.5}') + masked(0x89, b"p") + masked(0x82, os.urandom(300))
     parser, out = FrameParser(4096), []
