@@ -133,6 +133,11 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("PANELS_FILE", None, "optional_str",
             "TOML file defining the mission control panels; unset means the drone panel in "
             "rover_web/panels/drone.toml"),
+    Setting("PANEL_UNLOCKS_PER_MIN", 10, "int",
+            "unlock attempts one client (user, or address with sign-in off) may make a minute (429 beyond)", 1, 10000),
+    Setting("PANEL_REFUSALS_PER_MIN", 20, "int",
+            "refused or invalid panel commands one client may make a minute; beyond, its commands get 429 "
+            "and nothing more is logged", 1, 10000),
     Setting("PANELS_LOG_SHOWN", 20, "int", "operator-log entries a panel page shows (newest first)", 1, 500),
     Setting("PANELS_LOG_KEEP", 10000, "int", "operator-log entries kept per panel in the database (oldest deleted)",
             100, 10_000_000),
@@ -168,6 +173,9 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("CAMERA_MAX_VIEWERS", 24, "int",
             "most /stream and /snapshot requests served at once (503 beyond); each holds a server thread", 1, 1024),
     Setting("CAMERA_SNAPSHOT_TIMEOUT_S", 5.0, "float", "how long /snapshot waits for a frame", 0.1, 60),
+    Setting("CAMERA_SNAPSHOTS_PER_MIN", 120, "int",
+            "most /snapshot requests one client (user, or address with sign-in off) makes a minute (429 beyond)",
+            1, 100000),
     Setting("CAMERA_MAX_PRODUCERS", 8, "int",
             "most different streams (topic, size, quality, QoS) encoded at once; viewers of the same one "
             "share it (503 beyond)", 1, 256),

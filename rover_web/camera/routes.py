@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from flask import Blueprint, Response, jsonify, request
 
+from rover_web.auth import signed_in_name
 from rover_web.core.state import current_feature
 from rover_web.web.connection import peer_gone
-from rover_web.web.http import ApiError, error_response
+from rover_web.web.http import ApiError, error_response, too_many
 from rover_web.web.streams import once, opening
 from rover_web.web.validate import InvalidInput
 
@@ -69,6 +70,9 @@ def stream():
 @bp.get("/snapshot")
 def snapshot():
     streams = current_feature(CameraStreams)
+    wait = streams.snapshots.hit(signed_in_name() or request.remote_addr or "")
+    if wait:  # each one may subscribe and decode: one client's loop must not cost everyone's frames
+        raise too_many("snapshot requests (ROVER_WEB_CAMERA_SNAPSHOTS_PER_MIN)", wait)
     key = streams.key_for(request.args)
     producer = streams.acquire(key)
     try:

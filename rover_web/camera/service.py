@@ -7,6 +7,7 @@ import threading
 from collections.abc import Mapping
 
 from rover_web.core.leases import Closed, Full, Leases
+from rover_web.core.rate_limit import RateLimit
 from rover_web.core.state import Rover
 from rover_web.ros.graph import publishers_best_effort, topic_types
 from rover_web.ros.typesupport import UnknownMessageType, message_class
@@ -51,6 +52,7 @@ class CameraStreams:
         self.max_viewers = config["ROVER_WEB_CAMERA_MAX_VIEWERS"]
         self.snapshot_timeout_s = config["ROVER_WEB_CAMERA_SNAPSHOT_TIMEOUT_S"]
         self.max_output_pixels = config["ROVER_WEB_CAMERA_MAX_OUTPUT_PIXELS"]
+        self.snapshots = RateLimit(config["ROVER_WEB_CAMERA_SNAPSHOTS_PER_MIN"], 60.0)
         self.producers: Leases[FrameProducer] = Leases(self._open, self._close,
                                                        config["ROVER_WEB_CAMERA_IDLE_TIMEOUT_S"],
                                                        max_keys=config["ROVER_WEB_CAMERA_MAX_PRODUCERS"])

@@ -8,18 +8,21 @@ from rover_web.auth import signed_in_name
 from rover_web.core.state import current_feature
 from rover_web.web.http import ApiError, error_response, json_body
 
-from .service import CommandRefused, InvalidCommand, PanelError, PanelService, UnknownControl, UnknownPanel
+from .service import CommandRefused, InvalidCommand, PanelError, PanelService, TooMany, UnknownControl, UnknownPanel
 
 bp = Blueprint("panels", __name__)
 
 MAX_LOG_LIMIT = 500
 
-STATUS = {UnknownPanel: 404, UnknownControl: 404, InvalidCommand: 400, CommandRefused: 409}
+STATUS = {UnknownPanel: 404, UnknownControl: 404, InvalidCommand: 400, CommandRefused: 409, TooMany: 429}
 
 
 @bp.errorhandler(PanelError)
 def panel_error(exc: PanelError):
-    return error_response(STATUS[type(exc)], exc.code, str(exc))
+    response = error_response(STATUS[type(exc)], exc.code, str(exc))
+    if isinstance(exc, TooMany):
+        response.headers["Retry-After"] = str(max(1, int(exc.retry_after_s + 0.999)))
+    return response
 
 
 def service() -> PanelService:

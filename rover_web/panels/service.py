@@ -14,6 +14,7 @@ import threading
 import time
 from typing import Any
 
+from rover_web.core.rate_limit import RateLimit
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
 from rover_web.web.validate import InvalidInput, only_keys
@@ -55,6 +56,14 @@ class CommandRefused(PanelError):
     """A well-formed command the panel's state does not allow now (`locked`, `not_allowed`)."""
 
 
+class TooMany(PanelError):
+    """A client over its rate of unlock attempts or refused commands; nothing is done or logged."""
+
+    def __init__(self, message: str, retry_after_s: float):
+        super().__init__(message, "rate_limited")
+        self.retry_after_s = retry_after_s
+
+
 class PanelService:
     def __init__(self, specs: tuple[PanelSpec, ...], rover: Rover, oplog: OperatorLog, estop: EStopService):
         self.rover = rover
@@ -62,6 +71,9 @@ class PanelService:
         self.estop = estop
         self.specs = {s.id: s for s in specs}
         self.states = {s.id: PanelState(s, estop_engaged=lambda: estop.engaged) for s in specs}
+        # Per client: every refusal and unlock writes the operator log that everyone reads.
+        self.refusals = RateLimit(rover.config["ROVER_WEB_PANEL_REFUSALS_PER_MIN"], 60.0)
+        self.unlocks = RateLimit(rover.config["ROVER_WEB_PANEL_UNLOCKS_PER_MIN"], 60.0)
         self._view_lock = threading.Lock()
         self._last_view: dict | None = None
         runtime = rover.runtime
@@ -134,6 +146,10 @@ class PanelService:
 
     def unlock(self, panel_id: str, client: str) -> dict:
         state = self.panel(panel_id)
+        wait = self.unlocks.hit(client)
+        if wait:
+            raise TooMany(f"too many unlock attempts (ROVER_WEB_PANEL_UNLOCKS_PER_MIN); try again in "
+                          f"{max(1, int(wait + 0.999))} s", wait)
         with state.lock:
             self._expire(state)
             state.unlock()
@@ -164,6 +180,10 @@ class PanelService:
         if control is None:
             raise UnknownControl(f"panel {panel_id!r} has no control {control_id[:40]!r}; controls: "
                                  f"{', '.join(c.id for c in state.spec.controls)}", "unknown_control")
+        wait = self.refusals.retry_after_s(client)
+        if wait:  # checked before anything is logged: a client hammering refusals writes nothing more
+            raise TooMany(f"too many refused commands (ROVER_WEB_PANEL_REFUSALS_PER_MIN); try again in "
+                          f"{max(1, int(wait + 0.999))} s", wait)
         if isinstance(body_or_error, InvalidCommand):
             self._refuse(state, control, None, "invalid", body_or_error, client)
         body = body_or_error
@@ -205,6 +225,7 @@ class PanelService:
 
     def _refuse(self, state: PanelState, control: ControlSpec, value: Any, result: str, error: PanelError,
                 client: str) -> None:
+        self.refusals.record(client)
         self._record(state.spec.id, control.id, control.label, value, result, str(error), client)
         raise error
 

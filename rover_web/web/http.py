@@ -14,9 +14,16 @@ STATE_CHANGING = frozenset({"POST", "PUT", "PATCH", "DELETE"})
 
 
 class ApiError(Exception):
-    def __init__(self, status: int, code: str, message: str):
+    def __init__(self, status: int, code: str, message: str, retry_after_s: float | None = None):
         super().__init__(message)
         self.status, self.code, self.message = status, code, message
+        self.retry_after_s = retry_after_s
+
+
+def too_many(what: str, wait_s: float) -> ApiError:
+    """429 with the whole seconds to wait, in the message and in Retry-After."""
+    seconds = max(1, int(wait_s + 0.999))
+    return ApiError(429, "rate_limited", f"too many {what}; try again in {seconds} s", retry_after_s=seconds)
 
 
 def error_response(status: int, code: str, message: str):
@@ -142,7 +149,10 @@ def init_app(app: Flask) -> None:
 
     @app.errorhandler(ApiError)
     def _api_error(exc: ApiError):
-        return error_response(exc.status, exc.code, exc.message)
+        response = error_response(exc.status, exc.code, exc.message)
+        if exc.retry_after_s is not None:
+            response.headers["Retry-After"] = str(max(1, int(exc.retry_after_s + 0.999)))
+        return response
 
     @app.errorhandler(HTTPException)
     def _http_error(exc: HTTPException):

@@ -309,3 +309,14 @@ def test_an_asked_size_beyond_the_output_area_is_refused(live_server_factory):
     assert response.status_code == 400 and response.json()["error"] == "out_of_range"
     assert "ROVER_WEB_CAMERA_MAX_OUTPUT_PIXELS" in response.json()["message"]
     assert len(streams(server).producers) == 0
+
+
+def test_snapshot_requests_beyond_the_rate_get_429_with_retry_after(live_server_factory):
+    server = live_server_factory(ROVER_WEB_CAMERA_SNAPSHOTS_PER_MIN=2, ROVER_WEB_CAMERA_SNAPSHOT_TIMEOUT_S=0.2)
+    query = {"topic": "/test_cam/silent", "msg_type": IMAGE}
+    for _ in range(2):
+        assert requests.get(server.url + "/snapshot", params=query, timeout=10).status_code == 504
+    refused = requests.get(server.url + "/snapshot", params=query, timeout=10)
+    assert refused.status_code == 429 and refused.json()["error"] == "rate_limited"
+    assert 1 <= int(refused.headers["Retry-After"]) <= 60
+    assert len(streams(server).producers) == 0 or streams(server).viewers == 0

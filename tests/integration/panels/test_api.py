@@ -221,7 +221,7 @@ def test_operator_log_persists_in_sqlite_and_the_page_shows_the_newest(app_facto
 
 
 def test_the_log_keeps_only_the_newest_entries(app_factory):
-    client = app_factory(ROVER_WEB_PANELS_LOG_KEEP=100).test_client()
+    client = app_factory(ROVER_WEB_PANELS_LOG_KEEP=100, ROVER_WEB_PANEL_REFUSALS_PER_MIN=1000).test_client()
     for _ in range(105):
         client.post("/api/panels/drone/stop", json={})
     entries = client.get("/api/panels/drone/log?limit=500").json["entries"]
@@ -256,3 +256,27 @@ def test_a_malformed_panel_file_fails_at_start_naming_file_panel_and_field(app_f
         server.start(timeout=20)
     assert f"rover_web: {expected}" in server.log()
     assert "Traceback" not in server.log()
+
+
+def test_unlock_attempts_beyond_the_rate_get_429_with_retry_after_and_log_nothing(live_server_factory):
+    url = live_server_factory(ROVER_WEB_PANEL_UNLOCKS_PER_MIN=3).url
+    for _ in range(3):
+        assert post(url, "drone/unlock").status_code == 200
+    logged = len(log_entries(url))
+    refused = post(url, "drone/unlock")
+    assert refused.status_code == 429 and refused.json()["error"] == "rate_limited"
+    assert 1 <= int(refused.headers["Retry-After"]) <= 60
+    assert "ROVER_WEB_PANEL_UNLOCKS_PER_MIN" in refused.json()["message"]
+    assert len(log_entries(url)) == logged
+
+
+def test_refused_commands_beyond_the_rate_get_429_and_stop_filling_the_operator_log(live_server_factory):
+    """Each refusal writes the log every operator reads; one client's loop must not bury it."""
+    url = live_server_factory(ROVER_WEB_PANEL_REFUSALS_PER_MIN=4).url
+    for _ in range(4):
+        assert post(url, "drone/takeoff", {"confirmed": True}).status_code == 409  # locked
+    assert len(log_entries(url)) == 4
+    for _ in range(5):
+        refused = post(url, "drone/takeoff", {"confirmed": True})
+        assert refused.status_code == 429 and int(refused.headers["Retry-After"]) >= 1
+    assert len(log_entries(url)) == 4
