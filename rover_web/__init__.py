@@ -64,10 +64,17 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     from rover_web.events.hub import EventHub
     from rover_web.ros.cmd_vel import CmdVelOutput
     from rover_web.ros.runtime import RosRuntime
+    from rover_web.storage.claim import claim
     from rover_web.storage.db import Database, database_path
     from rover_web.web import pages, sse, status
 
-    runtime = RosRuntime(settings["ROVER_WEB_NODE_NAME"], settings["ROVER_WEB_ROS_DOMAIN_ID"])
+    db_path = database_path(app)
+    db_claim = claim(db_path)  # before the node: a refused second server never joins the ROS graph
+    try:
+        runtime = RosRuntime(settings["ROVER_WEB_NODE_NAME"], settings["ROVER_WEB_ROS_DOMAIN_ID"])
+    except BaseException:
+        db_claim.release()
+        raise
     rover = None
     try:
         cmd_vel = CmdVelOutput(runtime, settings["ROVER_WEB_CMD_VEL_TOPIC"],
@@ -76,8 +83,9 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
                                stamped=settings["ROVER_WEB_CMD_VEL_STAMPED"],
                                frame_id=settings["ROVER_WEB_CMD_VEL_FRAME_ID"])
         hub = EventHub(max_clients=settings["ROVER_WEB_SSE_MAX_CLIENTS"])
-        rover = Rover(settings, hub, runtime, cmd_vel, db=Database(database_path(app)),
+        rover = Rover(settings, hub, runtime, cmd_vel, db=Database(db_path),
                       broadcaster=Broadcaster(hub, settings["ROVER_WEB_SSE_KEEPALIVE_S"]))
+        rover.on_shutdown(db_claim.release)  # shutdown hooks run last first: after the database closes
         rover.on_shutdown(rover.db.close)
         app.extensions[EXTENSION] = rover
         auth.init_app(app, rover)  # first: every route after it is checked for sign-in and role
@@ -100,6 +108,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
             rover.shutdown()
         else:
             runtime.stop(0.5)
+            db_claim.release()
         raise
     app.register_blueprint(pages.bp)
     app.register_blueprint(status.bp)

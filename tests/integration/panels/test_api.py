@@ -206,10 +206,12 @@ def test_displays_stream_on_sse_and_go_stale(live_server_factory, tmp_path, ros_
 
 def test_operator_log_persists_in_sqlite_and_the_page_shows_the_newest(app_factory, tmp_path):
     db = str(tmp_path / "shared.sqlite3")
-    first = app_factory(ROVER_WEB_DB_PATH=db).test_client()
+    first_app = app_factory(ROVER_WEB_DB_PATH=db)
+    first = first_app.test_client()
     assert first.post("/api/panels/drone/takeoff", json={"confirmed": True}).status_code == 409
     assert first.post("/api/panels/drone/unlock", json={}).status_code == 200
     assert first.post("/api/panels/drone/takeoff", json={}).status_code == 400
+    first_app.extensions["rover_web"].shutdown()  # one server per database: the next one is a restart
     second = app_factory(ROVER_WEB_DB_PATH=db, ROVER_WEB_PANELS_LOG_SHOWN=2).test_client()
     entries = second.get("/api/panels/drone/log").json["entries"]
     assert [(e["control"], e["result"]) for e in entries] == [

@@ -1,0 +1,47 @@
+"""One server per database: a second server on the same SQLite file refuses to start, naming it."""
+
+import os
+import signal
+import subprocess
+import sys
+
+import pytest
+
+from rover_web.config import ConfigError
+
+
+def test_a_second_server_on_the_same_database_refuses_to_start_naming_the_file(server_process, tmp_path):
+    db = tmp_path / "shared.sqlite3"
+    first = server_process(env={"ROVER_WEB_DB_PATH": str(db)}).start()
+    second = server_process(env={"ROVER_WEB_DB_PATH": str(db)})
+    with pytest.raises(RuntimeError, match="server exited with"):
+        second.start(timeout=20)
+    assert f"rover_web: another rover_web server (pid {first.proc.pid}) is already using the database {db}" \
+        in second.log()
+    assert "Traceback" not in second.log()
+    # The CLI may still use the claimed file beside its server, and another file is not affected.
+    from tests.support.rospeer import subprocess_env
+
+    listed = subprocess.run([sys.executable, "-m", "flask", "--app", "rover_web", "users", "list"],
+                            env=subprocess_env(ROVER_WEB_DB_PATH=str(db)), capture_output=True, text=True,
+                            timeout=60)
+    assert listed.returncode == 0, listed.stderr
+    server_process(env={"ROVER_WEB_DB_PATH": str(tmp_path / "other.sqlite3")}).start()
+
+
+def test_a_killed_server_leaves_no_claim_behind(server_process, tmp_path):
+    db = tmp_path / "killed.sqlite3"
+    first = server_process(env={"ROVER_WEB_DB_PATH": str(db)}).start()
+    first.proc.send_signal(signal.SIGKILL)
+    first.proc.wait(10)
+    server_process(env={"ROVER_WEB_DB_PATH": str(db)}).start()  # the kernel dropped the lock with the process
+
+
+def test_in_one_process_the_claim_is_held_until_shutdown(app_factory, tmp_path):
+    db = tmp_path / "one.sqlite3"
+    app = app_factory(ROVER_WEB_DB_PATH=str(db))
+    with pytest.raises(ConfigError, match=str(db)) as refused:
+        app_factory(ROVER_WEB_DB_PATH=str(db))
+    assert f"pid {os.getpid()}" in str(refused.value)
+    app.extensions["rover_web"].shutdown()
+    app_factory(ROVER_WEB_DB_PATH=str(db))
