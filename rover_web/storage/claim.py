@@ -32,7 +32,11 @@ class DatabaseClaim:
 def claim(database: Path) -> DatabaseClaim:
     """Claim `database` for this process; ConfigError naming the file if another server has it."""
     lock_path = database.with_name(database.name + ".server-lock")
-    fd = os.open(lock_path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o600)
+    try:
+        fd = os.open(lock_path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o600)
+    except OSError as exc:
+        raise ConfigError(f"cannot claim the database {database}: {lock_path} cannot be opened for writing "
+                          f"({exc.strerror}); the server needs a writable folder for its database") from None
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:

@@ -16,11 +16,17 @@ from pathlib import Path
 
 from flask import Flask
 
+from rover_web.config import ConfigError
+
 
 def database_path(app: Flask) -> Path:
     configured = app.config.get("ROVER_WEB_DB_PATH")
     path = Path(configured) if configured else Path(app.instance_path) / "rover_web.sqlite3"
-    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"cannot use the database {path}: its folder cannot be made ({exc.strerror}); "
+                          f"set ROVER_WEB_DB_PATH to a file in a writable folder") from None
     return path
 
 

@@ -45,3 +45,14 @@ def test_in_one_process_the_claim_is_held_until_shutdown(app_factory, tmp_path):
     assert f"pid {os.getpid()}" in str(refused.value)
     app.extensions["rover_web"].shutdown()
     app_factory(ROVER_WEB_DB_PATH=str(db))
+
+
+
+def test_a_database_path_that_cannot_be_made_is_a_clear_error_not_a_traceback(server_process, tmp_path):
+    blocker = tmp_path / "not_a_folder"
+    blocker.write_text("a file where a folder should be")
+    server = server_process(env={"ROVER_WEB_DB_PATH": str(blocker / "db.sqlite3")})
+    with pytest.raises(RuntimeError, match="server exited with"):
+        server.start(timeout=20)
+    assert f"rover_web: cannot use the database {blocker / 'db.sqlite3'}" in server.log()
+    assert "Traceback" not in server.log()
