@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import sqlite3
-
-from flask import Blueprint, current_app, jsonify, render_template, request
+from flask import Blueprint, jsonify, render_template, request
 
 from rover_web.core.state import current_feature
 from rover_web.storage.group_commit import CommitterStopped
@@ -167,12 +165,6 @@ def _stale(exc: StaleRevision):
 @bp.errorhandler(EmptyMission)
 def _empty(exc: EmptyMission):
     return error_response(409, "empty_mission", "the mission has no waypoints; add at least one before sending it")
-
-
-@bp.errorhandler(sqlite3.OperationalError)
-def _storage(exc: sqlite3.OperationalError):
-    current_app.logger.error("waypoint storage: %s", exc)
-    return error_response(503, "storage_unavailable", f"the waypoint database could not be written: {exc}")
 
 
 @bp.errorhandler(CommitterStopped)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sqlite3
 from urllib.parse import urlsplit
 
 from flask import Flask, Request, current_app, jsonify, request
@@ -163,6 +164,16 @@ def init_app(app: Flask) -> None:
         if exc.code == 413:
             message = f"request body is larger than {current_app.config['ROVER_WEB_MAX_BODY_BYTES']} bytes"
         return error_response(exc.code or 500, code, message)
+
+    @app.errorhandler(sqlite3.Error)
+    def _storage(exc: sqlite3.Error):
+        # A disk that is full or failing is the machine's state, not a bug: say which, and nothing
+        # was stored (the transaction rolled back). Motion never waits on the disk.
+        current_app.logger.error("database error on %s %s: %s", request.method, request.path, exc)
+        if getattr(exc, "sqlite_errorname", "") == "SQLITE_FULL":
+            return error_response(507, "disk_full", "the disk under the database is full; nothing was stored. "
+                                                    "Free space on it and try again")
+        return error_response(503, "storage_unavailable", f"the database could not be used: {exc}; nothing was stored")
 
     @app.errorhandler(Exception)
     def _unexpected(exc: Exception):
