@@ -105,4 +105,5 @@ class WaypointsService:
         }
 
     def panel_context(self) -> dict:
-        return {"mission": self.store.mission(), "map": self.map_config(), "fix": self.track.state()}
+        return {"mission": self.store.mission(), "map": self.map_config(), "fix": self.track.state(),
+                "geofence": self.geofence.collection()}
