@@ -131,10 +131,9 @@ SETTINGS: tuple[Setting, ...] = (
             "unset or missing means no basemap"),
     # --- geofence ---
     Setting("GEOFENCE_MAX_VERTICES", 2000, "int", "most vertices a geofence may have in all (400 beyond)", 4, 100000),
-    Setting("GEOFENCE_ESTOP", False, "bool", "engage the e-stop when the robot's /fix leaves the geofence"),
+    Setting("GEOFENCE_ESTOP", False, "bool", "engage the e-stop when /fix leaves the geofence"),
     Setting("GEOFENCE_FILE", None, "optional_str",
-            "GeoJSON fence stored when the database has none yet (relative paths from the repository root); "
-            "the demo uses map_files/geofence.geojson"),
+            "GeoJSON fence stored when the database has none (the demo: map_files/geofence.geojson)"),
     # --- panels ---
     Setting("PANELS_FILE", None, "optional_str",
             "TOML file defining the mission control panels; unset means the drone panel in "

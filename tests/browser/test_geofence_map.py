@@ -99,3 +99,19 @@ def test_draw_a_fence_then_a_click_outside_it_is_refused_visibly(live_server_fac
     assert "bowtie" in page.locator("#gf-message").inner_text()
     assert fence(server.url)["revision"] == 4
     assert page.watch.offhost == []
+
+
+def test_livemap_draws_keep_out_areas_and_a_goal_inside_one_is_refused(live_server, page):
+    from tests.browser.test_livemap import canvas_origin, canvas_rgb, expected_screen
+    from tests.browser.test_livemap import open_map as open_livemap
+
+    s = open_livemap(page, live_server.url)
+    assert s["keep_out"] == 1
+    x, y = expected_screen(s, 35.75, 2.0)  # the middle of the electrical room
+    r, g, b = canvas_rgb(page, x, y)
+    assert r > g + 40 and r > b + 40  # tinted red
+    left, top = canvas_origin(page)
+    page.click("#livemap-goal-mode")
+    page.mouse.click(left + x, top + y)
+    page.wait_for_function("() => /Goal refused: .*electrical room/.test(document.body.innerText)")
+    assert page.evaluate("window.liveMapState.goal") is None
