@@ -35,11 +35,11 @@ def init_app(app, rover: Rover) -> None:
     service = GeofenceService(GeofenceStore(rover.db), rover.feature(EStopService), rover.hub,
                               max_vertices=config["ROVER_WEB_GEOFENCE_MAX_VERTICES"],
                               engage_estop=config["ROVER_WEB_GEOFENCE_ESTOP"])
+    rover.hub.register(CHANNEL)
     if config["ROVER_WEB_GEOFENCE_FILE"]:
         service.seed(_read_file(config["ROVER_WEB_GEOFENCE_FILE"], service.max_vertices))
     rover.add_feature(service)
     app.register_blueprint(routes.bp)
-    rover.hub.register(CHANNEL)
     rover.hub.publish(CHANNEL, service.state())
     rover.every(CHECK_PERIOD_S, service.evaluate, name="geofence-check", only_while=service.pending)
     app.context_processor(lambda: {"geofence_state": service.state()})
