@@ -115,3 +115,20 @@ def test_without_the_setting_a_breach_is_only_an_event(live_server, ros_peer, ss
     assert requests.get(live_server.url + "/api/estop", timeout=5).json()["engaged"] is False
     page = requests.get(live_server.url + "/waypoints", timeout=5).text
     assert 'id="geofence-banner"' in page and "left the geofence" in page
+
+
+def test_the_simulators_fix_inside_the_demo_fence_then_a_fence_that_excludes_it_is_a_breach(
+        live_server_factory, sim_process, sse_client):
+    from rover_web.demo import DEMO_GEOFENCE
+    from tests.support.geofence_helpers import area, collection, square
+
+    server = live_server_factory(ROVER_WEB_GEOFENCE_FILE=DEMO_GEOFENCE, ROVER_WEB_GEOFENCE_ESTOP=True)
+    stream = sse_client(server.url + "/api/events?channels=geofence,estop")
+    sim_process("--only", "rover")
+    inside = stream.wait_for("geofence", lambda d: d["state"] == "inside", timeout=20)["json"]
+    assert inside["areas"] == 2 and inside["revision"] == 1
+    # Move the keep-in 2 km east: the simulated rover, parked at its start, is now outside it.
+    put_fence(server.url, collection(area("keep_in", square(-82.43, 27.36, -82.42, 27.39))))
+    left = stream.wait_for("geofence", lambda d: d["state"] == "outside", timeout=10)["json"]
+    assert left["lng"] < -82.44 and left["revision"] == 2
+    assert stream.wait_for("estop", lambda d: d["engaged"])["json"]["by"] == "geofence breach"
