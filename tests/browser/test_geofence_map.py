@@ -115,3 +115,21 @@ def test_livemap_draws_keep_out_areas_and_a_goal_inside_one_is_refused(live_serv
     page.mouse.click(left + x, top + y)
     page.wait_for_function("() => /Goal refused: .*electrical room/.test(document.body.innerText)")
     assert page.evaluate("window.liveMapState.goal") is None
+
+
+def test_every_page_shows_the_breach_banner_live(live_server, page):
+    from rover_web.geofence import GeofenceService
+    from tests.support.geofence_helpers import INSIDE, OUTSIDE
+
+    requests.put(live_server.url + "/api/geofence", json=FENCE, timeout=5).raise_for_status()
+    watch = live_server.rover.feature(GeofenceService)
+    page.goto(live_server.url + "/topics")
+    page.wait_for_selector("#link-server[data-state='live']", timeout=10000)
+    assert page.locator("#geofence-banner").is_hidden()
+    # What the /fix callback does with a position (tests/integration/geofence/test_ros.py sends
+    # real NavSatFix messages from another process).
+    watch.note_position(*OUTSIDE)
+    page.wait_for_selector("#geofence-banner", state="visible")
+    assert "outside every keep-in area" in page.locator("#geofence-banner").inner_text()
+    watch.note_position(*INSIDE)
+    page.wait_for_selector("#geofence-banner", state="hidden")
