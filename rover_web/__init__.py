@@ -58,7 +58,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         return app  # a CLI command, not a server: no node, no database, no stop-on-exit hooks
 
     require_rclpy()
-    from rover_web import camera, estop, livemap, panels, scan_the_code, telemetry, teleop, topics, waypoints
+    from rover_web import camera, estop, geofence, livemap, panels, scan_the_code, telemetry, teleop, topics, waypoints
     from rover_web.core.state import EXTENSION, Rover
     from rover_web.events.broadcast import Broadcaster
     from rover_web.events.hub import EventHub
@@ -90,6 +90,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         app.extensions[EXTENSION] = rover
         auth.init_app(app, rover)  # first: every route after it is checked for sign-in and role
         estop.init_app(app, rover)  # before every feature that moves the robot: they gate on it
+        geofence.init_app(app, rover)  # before waypoints and livemap: they check it before publishing
         # Features, in dashboard order of their cards; each registers its routes, channels,
         # subscriptions and panels.
         telemetry.init_app(app, rover)

@@ -129,6 +129,11 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("MAP_TILES", "map_files/tiles", "optional_str",
             "offline basemap: a z/x/y tile folder or an .mbtiles file (relative paths from the repository root); "
             "unset or missing means no basemap"),
+    # --- geofence ---
+    Setting("GEOFENCE_MAX_VERTICES", 2000, "int", "most vertices a geofence may have in all (400 beyond)", 4, 100000),
+    Setting("GEOFENCE_ESTOP", False, "bool", "engage the e-stop when /fix leaves the geofence"),
+    Setting("GEOFENCE_FILE", None, "optional_str",
+            "GeoJSON fence stored when the database has none (the demo: map_files/geofence.geojson)"),
     # --- panels ---
     Setting("PANELS_FILE", None, "optional_str",
             "TOML file defining the mission control panels; unset means the drone panel in "

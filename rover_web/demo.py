@@ -12,6 +12,8 @@ import signal
 import subprocess
 import sys
 
+DEMO_GEOFENCE = "map_files/geofence.geojson"
+
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m rover_web.demo", description=__doc__)
@@ -37,6 +39,9 @@ def main(argv: list[str] | None = None) -> int:
     except config_module.ConfigError as exc:
         raise SystemExit(f"rover_web: {exc}") from None
     os.environ["ROVER_WEB_HOST"] = host
+    # The simulator drives around Nathan Benderson Park: its fence is stored when the demo's
+    # database has none, so the map shows one and leaving it raises the breach warning.
+    os.environ.setdefault("ROVER_WEB_GEOFENCE_FILE", DEMO_GEOFENCE)
     app = create_app()
     config = app.config
     port = args.port or config["ROVER_WEB_PORT"]

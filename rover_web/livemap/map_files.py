@@ -36,6 +36,7 @@ from PIL import Image, ImageOps
 from rover_web.config import ROOT, ConfigError
 
 from .geometry import MapGeometry, wrap_angle
+from .keep_out import KeepOutArea, parse_keep_out
 
 IMAGE_SUFFIXES = (".png", ".pgm")
 MAP_IMAGE_FORMATS = ("PNG", "PPM")  # Pillow reads PGM as its PPM format; nothing else is opened
@@ -72,6 +73,7 @@ class MapDefinition:
     version: int = 1
     image_path: Path | None = None
     renderer: Callable[[], bytes] | None = field(default=None, repr=False)  # live maps draw their own PNG
+    keep_out: tuple[KeepOutArea, ...] = ()  # goals inside one are refused (keep_out.py)
     _png: bytes | None = field(default=None, repr=False)
     _thumbnail: bytes | None = field(default=None, repr=False)
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
@@ -320,15 +322,25 @@ def _relative_dir(directory: Path, root: Path) -> str:
 
 
 def _catalog_entry(name: str, entry: Any, root: Path, src: _Source) -> MapDefinition:
+    definition = _catalog_map(name, entry, root, src)
+    if "keep_out" in entry:
+        try:
+            definition.keep_out = parse_keep_out(entry["keep_out"], f"{json.dumps(name)}.keep_out")
+        except ValueError as exc:
+            raise src.error("", str(exc)) from None
+    return definition
+
+
+def _catalog_map(name: str, entry: Any, root: Path, src: _Source) -> MapDefinition:
     key = json.dumps(name)
     if not isinstance(entry, dict):
         raise src.error(key, f"expected an object with files and yaml_parameters, got {type(entry).__name__}")
     files = entry.get("files")
     if not isinstance(files, dict):
         raise src.error(f"{key}.files", "missing or not an object")
-    unknown = sorted(set(entry) - {"files", "yaml_parameters"})
+    unknown = sorted(set(entry) - {"files", "yaml_parameters", "keep_out"})
     if unknown:
-        raise src.error(f"{key}.{unknown[0]}", "unknown key; an entry has files and yaml_parameters")
+        raise src.error(f"{key}.{unknown[0]}", "unknown key; an entry has files, yaml_parameters and keep_out")
     unknown = sorted(set(files) - {"path", "png_file", "yaml_file", "waypoint_file"})
     if unknown:
         raise src.error(f"{key}.files.{unknown[0]}",

@@ -8,6 +8,7 @@ from urllib.parse import quote
 from flask import Blueprint, Response, abort, jsonify, redirect, render_template, request, url_for
 
 from rover_web.core.state import current_feature
+from rover_web.geofence import OutsideGeofence, outside_geofence_response
 from rover_web.web.http import ApiError, error_response, json_body
 from rover_web.web.validate import InvalidInput, number, only_keys
 
@@ -28,6 +29,11 @@ def outside_map(exc: OutsideMap):
     return error_response(400, "outside_map", str(exc))
 
 
+@bp.errorhandler(OutsideGeofence)
+def inside_keep_out(exc: OutsideGeofence):
+    return outside_geofence_response(exc)
+
+
 @bp.errorhandler(ShuttingDown)
 def shutting_down(exc: ShuttingDown):
     return error_response(503, "stopping", str(exc))
@@ -43,6 +49,7 @@ def map_summary(definition: MapDefinition) -> dict:
         "width_px": g.width_px, "height_px": g.height_px, "resolution_m": g.resolution_m,
         "cm_per_pixel": g.cm_per_pixel, "width_m": round(g.width_m, 6), "height_m": round(g.height_m, 6),
         "origin": [g.origin_x, g.origin_y, g.origin_yaw], "waypoint_count": len(definition.waypoints),
+        "keep_out": [a.as_dict() for a in definition.keep_out],
         "urls": {"state": f"/api/maps/{quoted}", "image": f"/api/maps/{quoted}/image{version}",
                  "thumbnail": f"/api/maps/{quoted}/thumbnail{version}", "page": f"/livemap/{quoted}",
                  "goal": f"/api/maps/{quoted}/goal"},

@@ -13,6 +13,7 @@ from rover_web.estop import EStopService
 
 from . import msgs
 from .geometry import MapGeometry, wrap_angle
+from .keep_out import check_goal
 from .map_files import MAX_IMAGE_SIDE_PX, MapDefinition, load_catalog, maps_file_path
 from .occupancy import grid_to_image, image_to_png
 from .state import LiveMap, Pose2D, RobotTrack, UnknownMap, goal_payload, plan_payload, pose_payload
@@ -157,6 +158,7 @@ class LiveMapService:
             raise OutsideMap(f"({x:g}, {y:g}) is outside {definition.name!r}, which spans "
                              f"x {min(corners[0][0], corners[1][0]):g}..{max(corners[0][0], corners[1][0]):g} m, "
                              f"y {min(corners[0][1], corners[1][1]):g}..{max(corners[0][1], corners[1][1]):g} m")
+        check_goal(definition.keep_out, definition.name, x, y)  # OutsideGeofence: 422, nothing sent
         if self.rover.stopping.is_set():
             raise ShuttingDown("the server is shutting down; no goal was sent")
         self.estop.check_motion()

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
+from rover_web.geofence import GeofenceService
 
 from . import broadcaster, routes
 from .msgs import NAV_SAT_FIX, fix_reading
@@ -26,7 +27,7 @@ from .service import FIX_CHANNEL, WaypointsService
 
 
 def init_app(app, rover: Rover) -> None:
-    service = WaypointsService(rover, rover.feature(EStopService))
+    service = WaypointsService(rover, rover.feature(EStopService), rover.feature(GeofenceService))
     rover.add_feature(service)
     app.register_blueprint(routes.bp)
     rover.hub.register(broadcaster.CHANNEL, FIX_CHANNEL)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from flask import Blueprint, jsonify, render_template, request
 
 from rover_web.core.state import current_feature
+from rover_web.geofence import OutsideGeofence, outside_geofence_response
 from rover_web.storage.group_commit import CommitterStopped
 from rover_web.web.http import error_response, json_body
 from rover_web.web.validate import InvalidInput, only_keys
@@ -97,9 +98,8 @@ def update_waypoint(waypoint_id: int):
     lat = check_lat(body["lat"]) if "lat" in body else None
     label = check_label(body["label"]) if "label" in body else None
     index = _integer(body, "index")
-    service = current_feature(WaypointsService)
-    waypoint, revision = service.store.update(_waypoint_id(waypoint_id), lng=lng, lat=lat, label=label, index=index)
-    service.changed()
+    waypoint, revision = current_feature(WaypointsService).move(_waypoint_id(waypoint_id), lng=lng, lat=lat,
+                                                                label=label, index=index)
     return jsonify(waypoint=waypoint.to_dict(), revision=revision)
 
 
@@ -131,8 +131,7 @@ def export_geojson():
 def import_geojson():
     service = current_feature(WaypointsService)
     points = waypoints_from_geojson(json_body(), service.store.max_waypoints)
-    mission = service.store.replace(points)
-    service.changed()
+    mission = service.replace(points)
     return jsonify({**mission.to_dict(), "max": service.store.max_waypoints})
 
 
@@ -149,6 +148,11 @@ def _full(exc: MissionFull):
     return error_response(409, "too_many_waypoints",
                           f"the mission may hold at most {exc.args[0]} waypoints (ROVER_WEB_MAX_WAYPOINTS); "
                           "delete some first")
+
+
+@bp.errorhandler(OutsideGeofence)
+def _outside_geofence(exc: OutsideGeofence):
+    return outside_geofence_response(exc)
 
 
 @bp.errorhandler(WaypointNotFound)

@@ -7,11 +7,12 @@ import logging
 from rover_web.basemap.source import basemap
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
+from rover_web.geofence import GeofenceService, OutsideGeofence
 
 from .broadcaster import MissionBroadcaster
 from .gps import FixReading, GpsTrack
 from .msgs import FLOAT64_MULTI_ARRAY, mission_message, waypoint_message
-from .store import EmptyMission, StaleRevision, Waypoint, WaypointStore
+from .store import EmptyMission, Mission, StaleRevision, Waypoint, WaypointStore
 
 FIX_CHANNEL = "fix"
 FIX_CHANNEL_MAX_HZ = 5.0
@@ -23,10 +24,11 @@ WAYPOINT_QOS_DEPTH = 1000
 
 
 class WaypointsService:
-    def __init__(self, rover: Rover, estop: EStopService):
+    def __init__(self, rover: Rover, estop: EStopService, geofence: GeofenceService):
         config = rover.config
         self.config = config
         self.estop = estop
+        self.geofence = geofence
         self.store = WaypointStore(rover.db, config["ROVER_WEB_MAX_WAYPOINTS"])
         runtime = rover.runtime
         self.waypoint_topic = config["ROVER_WEB_WAYPOINTS_TOPIC"]
@@ -40,11 +42,14 @@ class WaypointsService:
     def on_fix(self, reading: FixReading) -> None:
         state = self.track.update(reading)
         self.hub.publish_throttled(FIX_CHANNEL, state, FIX_CHANNEL_MAX_HZ)
+        if state["fix"]:
+            self.geofence.note_position(state["lng"], state["lat"])
 
     # --- changes ---
 
     def add(self, lng: float, lat: float, label: str = "") -> Waypoint:
         self.estop.check_motion()  # every add is published on /waypoints: a command to the robot
+        self.geofence.check_point(lng, lat)  # refused before it is stored or published
         # Published once committed, by the committer thread: /waypoints carries the waypoints in
         # the mission's order even when several browsers or scripts add at the same moment.
         waypoint, _revision = self.store.add(lng, lat, label, announce=self._announce)
@@ -57,6 +62,22 @@ class WaypointsService:
             return
         self.waypoint_pub.publish(waypoint_message(waypoint.lng, waypoint.lat))
 
+    def move(self, waypoint_id: int, **changes) -> tuple[Waypoint, int]:
+        """Update one waypoint; a move outside the geofence is refused inside the transaction."""
+        result = self.store.update(waypoint_id, check=self.geofence.check_point, **changes)
+        self.broadcaster.changed()
+        return result
+
+    def replace(self, points) -> Mission:
+        """The GeoJSON import: every point must lie inside the geofence, or nothing changes."""
+        for i, (lng, lat, _label) in enumerate(points):
+            refused = self.geofence.fence.refusal(lng, lat)
+            if refused is not None:
+                raise OutsideGeofence(f"features[{i}]: {refused}", **refused.details, waypoint=i)
+        mission = self.store.replace(points)
+        self.broadcaster.changed()
+        return mission
+
     def changed(self) -> None:
         self.broadcaster.changed()
 
@@ -67,6 +88,7 @@ class WaypointsService:
         if not mission.waypoints:
             raise EmptyMission()
         self.estop.check_motion()
+        self.geofence.check_route([(w.lng, w.lat) for w in mission.waypoints])
         self.mission_pub.publish(mission_message([(w.lng, w.lat) for w in mission.waypoints]))
         return {"sent": len(mission.waypoints), "topic": self.mission_topic, **mission.to_dict()}
 
@@ -83,4 +105,5 @@ class WaypointsService:
         }
 
     def panel_context(self) -> dict:
-        return {"mission": self.store.mission(), "map": self.map_config(), "fix": self.track.state()}
+        return {"mission": self.store.mission(), "map": self.map_config(), "fix": self.track.state(),
+                "geofence": self.geofence.collection()}

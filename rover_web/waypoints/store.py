@@ -164,17 +164,25 @@ class WaypointStore:
         return self._commit(change, after)
 
     def update(self, waypoint_id: int, *, lng: float | None = None, lat: float | None = None,
-               label: str | None = None, index: int | None = None) -> tuple[Waypoint, int]:
-        """Move (lng/lat), rename, and/or reorder (index, 0-based; clamped to the list) one waypoint."""
+               label: str | None = None, index: int | None = None,
+               check: Callable[[float, float], None] | None = None) -> tuple[Waypoint, int]:
+        """Move (lng/lat), rename, and/or reorder (index, 0-based; clamped to the list) one waypoint.
+
+        check(lng, lat), when given, sees a moved waypoint's new position inside the transaction and
+        may raise to refuse the move (the geofence): nothing is then changed.
+        """
         def change(conn):
             row = conn.execute("SELECT id, position, lng, lat, label FROM waypoints WHERE id = ?",
                                (waypoint_id,)).fetchone()
             if row is None:
                 raise WaypointNotFound(waypoint_id)
             current = _row(row)
+            new_lng = current.lng if lng is None else lng
+            new_lat = current.lat if lat is None else lat
+            if check is not None and (lng is not None or lat is not None):
+                check(new_lng, new_lat)
             conn.execute("UPDATE waypoints SET lng = ?, lat = ?, label = ? WHERE id = ?",
-                         (current.lng if lng is None else lng, current.lat if lat is None else lat,
-                          current.label if label is None else label, waypoint_id))
+                         (new_lng, new_lat, current.label if label is None else label, waypoint_id))
             if index is not None:
                 ids = [r[0] for r in conn.execute("SELECT id FROM waypoints ORDER BY position")]
                 ids.remove(waypoint_id)

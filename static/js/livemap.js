@@ -28,6 +28,7 @@ const S = {
   geometry: geometryOf(params),
   botRadiusM: params.bot_radius / 100,
   waypoints: params.waypoints,
+  keepOut: data.map.keep_out || [],
   pose: null,
   goal: null,
   plan: data.plan,
@@ -63,7 +64,7 @@ function draw() {
   const drawn = drawScene(ctx, {
     image: S.imageLoaded ? image : null, geometry: S.geometry, view: S.view, size: S.size,
     dpr: window.devicePixelRatio || 1, plan: S.plan, waypoints: S.waypoints, goal: S.goal, pose: S.pose,
-    poseStale: noPose(), preview: S.preview, botRadiusM: S.botRadiusM,
+    poseStale: noPose(), preview: S.preview, botRadiusM: S.botRadiusM, keepOut: S.keepOut,
   });
   S.drawCount += 1;
   publish(root, S, drawn, noPose());

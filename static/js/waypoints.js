@@ -4,6 +4,7 @@
 // revision wins. Untrusted text (labels) only ever goes through textContent.
 import { api } from './api.js';
 import { on } from './live.js';
+import { attachGeofence } from './geofence_map.js';
 
 const el = document.getElementById('wp-map');
 if (el) init(el);
@@ -261,7 +262,9 @@ function init(container) {
     note.textContent = `The map cannot be shown in this browser (${err.message}); the list still works.`;
     map = null;
   }
+  let geofence = { handleClick: () => false };
   if (map) {
+    geofence = attachGeofence(map);
     map.touchZoomRotate.disableRotation();
     map.addControl(new maplibregl.NavigationControl({ showCompass: false }));
     map.addControl(new maplibregl.ScaleControl({ unit: 'metric' }));
@@ -281,6 +284,7 @@ function init(container) {
     map.on('click', (e) => {
       const target = e.originalEvent && e.originalEvent.target;
       if (target && target.closest && target.closest('.maplibregl-marker, .maplibregl-popup')) return;
+      if (geofence.handleClick(e)) return;  // editing the fence
       addAt(e.lngLat);
     });
     map.on('mousemove', (e) => { $('wp-cursor').textContent = fmtLatLng(e.lngLat.lat, e.lngLat.lng); });

@@ -3,7 +3,7 @@
 import { insideMap, isDrag, screenAngle, screenOfMapYaw, worldToScreen } from './geometry.js';
 
 export const COLORS = { robot: '#1f6feb', robotStale: '#6e7681', heading: '#ffffff', goal: '#f0883e',
-  plan: '#3fb950', waypoint: '#d2a8ff', preview: '#f0883e', background: '#0b0f13' };
+  plan: '#3fb950', waypoint: '#d2a8ff', preview: '#f0883e', background: '#0b0f13', keepOut: '#f85149' };
 // The robot at its real size, but never smaller than a dot one can find.
 const MIN_ROBOT_PX = 5;
 
@@ -68,6 +68,23 @@ function drawRobot(ctx, sx, sy, angle, radius, stale) {
   ctx.globalAlpha = 1;
 }
 
+// Keep-out areas (map metres, from all_maps.json): goals inside them are refused by the server.
+function drawKeepOut(ctx, toScreen, areas) {
+  ctx.strokeStyle = COLORS.keepOut;
+  ctx.fillStyle = `${COLORS.keepOut}55`;
+  ctx.lineWidth = 2;
+  for (const area of areas) {
+    ctx.beginPath();
+    area.polygon.forEach(([x, y], i) => {
+      const [sx, sy] = toScreen(x, y);
+      if (i === 0) ctx.moveTo(sx, sy); else ctx.lineTo(sx, sy);
+    });
+    ctx.closePath();
+    ctx.fill();
+    ctx.stroke();
+  }
+}
+
 function ring(ctx, sx, sy, radius, color) {
   ctx.strokeStyle = color;
   ctx.lineWidth = 2;
@@ -77,7 +94,7 @@ function ring(ctx, sx, sy, radius, color) {
 }
 
 // scene: { image (null until loaded), geometry, view, size, dpr, plan, waypoints, goal, pose,
-// poseStale, preview, botRadiusM }.
+// poseStale, preview, botRadiusM, keepOut }.
 export function drawScene(ctx, scene) {
   const { geometry: g, view, size } = scene;
   const toScreen = (x, y) => worldToScreen(g, view, x, y);
@@ -89,7 +106,8 @@ export function drawScene(ctx, scene) {
     ctx.drawImage(scene.image, view.ox, view.oy, g.w * view.scale, g.h * view.scale);
   }
   const { plan } = scene;
-  const drawn = { waypoints: [], pose: null, goal: null, plan: null };
+  const drawn = { waypoints: [], pose: null, goal: null, plan: null, keep_out: (scene.keepOut || []).length };
+  drawKeepOut(ctx, toScreen, scene.keepOut || []);
 
   drawPlan(ctx, toScreen, plan);
   drawn.plan = plan ? { points: plan.points.length, length: plan.length, frame_id: plan.frame_id } : null;

@@ -21,6 +21,7 @@ REQUESTS = [
     ("POST", "/api/panels/drone/unlock", {}, "operator", "/api/panels/<panel_id>/unlock"),
     ("POST", "/api/panels/drone/stop", {}, "operator", "/api/panels/<panel_id>/<control_id>"),
     ("POST", "/api/panels/drone/lock", {}, "operator", "/api/panels/<panel_id>/lock"),
+    ("PUT", "/api/geofence", {"type": "FeatureCollection", "features": []}, "operator", "/api/geofence"),
     ("POST", "/waypoints", {"lng": -71.0, "lat": 42.0}, "operator", "/waypoints"),
     ("POST", "/api/waypoints", {"lng": -71.001, "lat": 42.001}, "operator", "/api/waypoints"),
     ("PATCH", "/api/waypoints/{waypoint}", {"label": "dock"}, "operator", "/api/waypoints/<int:waypoint_id>"),

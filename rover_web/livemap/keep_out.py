@@ -1,0 +1,73 @@
+"""Keep-out areas of a floorplan, in map metres (`keep_out` in all_maps.json). Pure Python on shapely.
+
+    "keep_out": [{"name": "electrical room", "polygon": [[34, 0], [37.5, 0], [37.5, 4], [34, 4]]}]
+
+A polygon is at least three [x, y] points (closing it by repeating the first is optional), simple
+(no self-intersection), with an area. A goal on the edge of a keep-out area is inside it, as in the
+GPS geofence (rover_web/geofence/rules.py), and refused.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import shapely
+from shapely.geometry import Point, Polygon
+
+from rover_web.geofence import OutsideGeofence
+
+MAX_POINTS = 1000
+
+
+@dataclass(frozen=True)
+class KeepOutArea:
+    name: str
+    points: tuple[tuple[float, float], ...]
+    polygon: Polygon = field(repr=False, compare=False)
+
+    def as_dict(self) -> dict:
+        return {"name": self.name, "polygon": [list(p) for p in self.points]}
+
+
+def parse_keep_out(raw: Any, where: str) -> tuple[KeepOutArea, ...]:
+    """The areas, or ValueError naming the key (the map loader turns it into a ConfigError)."""
+    if not isinstance(raw, list):
+        raise ValueError(f"{where}: expected a list of {{\"name\": ..., \"polygon\": [[x, y], ...]}}")
+    return tuple(_area(item, f"{where}[{i}]") for i, item in enumerate(raw))
+
+
+def _area(item: Any, where: str) -> KeepOutArea:
+    if not isinstance(item, dict) or set(item) - {"name", "polygon"} or "polygon" not in item:
+        raise ValueError(f"{where}: expected {{\"name\": ..., \"polygon\": [[x, y], ...]}}")
+    name = item.get("name", "")
+    if not isinstance(name, str) or len(name) > 80:
+        raise ValueError(f"{where}.name: a string of at most 80 characters")
+    raw = item["polygon"]
+    if not isinstance(raw, list) or not 3 <= len(raw) <= MAX_POINTS:
+        raise ValueError(f"{where}.polygon: 3 to {MAX_POINTS} [x, y] points in metres")
+    points = []
+    for n, p in enumerate(raw):
+        if (not isinstance(p, list) or len(p) != 2
+                or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in p)):
+            raise ValueError(f"{where}.polygon[{n}]: expected [x, y], two finite numbers in metres")
+        points.append((float(p[0]), float(p[1])))
+    if points[0] == points[-1]:
+        points.pop()
+    polygon = Polygon(points)
+    reason = shapely.is_valid_reason(polygon)
+    if len(points) < 3 or reason != "Valid Geometry" or polygon.area <= 0:
+        raise ValueError(f"{where}.polygon: not a simple polygon with an area ({reason})")
+    shapely.prepare(polygon)
+    return KeepOutArea(name, tuple(points), polygon)
+
+
+def check_goal(areas: tuple[KeepOutArea, ...], map_name: str, x: float, y: float) -> None:
+    """OutsideGeofence when (x, y) lies in (or on the edge of) a keep-out area."""
+    point = Point(x, y)
+    for i, area in enumerate(areas):
+        if area.polygon.intersects(point):
+            title = f"keep-out area {area.name!r}" if area.name else f"keep-out area {i}"
+            raise OutsideGeofence(f"({x:g}, {y:g}) is inside the {title} of {map_name!r}",
+                                  reason="inside_keep_out", x=x, y=y, feature=i, name=area.name)
