@@ -212,6 +212,66 @@ def test_a_hidden_tab_stops_the_gamepad_and_frames_go_out_at_the_teleop_rate(rig
     assert page.watch.console_errors == []
 
 
+def test_estop_stops_the_gamepad_and_a_held_stick_must_come_back_to_rearm(rig, page):
+    server, peer = rig
+    open_dashboard(page, server)
+    page.evaluate("window.__pad.connect()")
+    pad(page, axes=[0, -1], enable=True)
+    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == 5.0, timeout=5.0)
+    peer.clear("/cmd_vel")
+    t = time.monotonic()
+    page.locator("#estop-engage").click()
+    zero = assert_stops_soon(peer, t, "e-stop")
+    page.wait_for_selector("#teleop-card[data-mode='estop']", timeout=5000)
+
+    # Released with enable and the stick still held: nothing moves until the stick comes back.
+    page.locator("#estop-release").click()
+    page.wait_for_selector("#estop[data-engaged='no']", timeout=5000)
+    page.wait_for_function("document.getElementById('teleop-message').textContent.includes('to re-arm')",
+                           timeout=5000)
+    pad(page, axes=[0, -0.9])  # a changed value, still pushed: refused as well
+    time.sleep(0.4)
+    assert all(lin == 0.0 for t, lin, _ in twists(peer) if t >= zero["t"])
+    pad(page, axes=[0, 0])     # neutral, enable still held: re-armed
+    page.wait_for_function("document.getElementById('gamepad-stick').textContent === 'linear 0.00, angular 0.00'",
+                           timeout=5000)
+    time.sleep(0.1)
+    pad(page, axes=[0, -1])
+    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == 5.0, timeout=5.0)
+    pad(page, enable=False)
+    peer.wait_for("/cmd_vel", is_zero, timeout=2.0)
+    assert page.watch.console_errors == []
+
+
+def test_a_reading_that_stalls_while_enable_is_held_stops_the_robot(rig, page):
+    """No animation frame while the page stays visible (a stalled page): the held command is not
+    repeated from a stale reading; the page says stop within its keep-alive, long before the 5 s deadman."""
+    server, peer = rig
+    page.add_init_script("""(() => {
+        const real = window.requestAnimationFrame.bind(window);
+        let paused = false;
+        const held = [];
+        window.requestAnimationFrame = (cb) => (paused ? (held.push(cb), -1) : real(cb));
+        window.__raf = { pause() { paused = true; },
+                         resume() { paused = false; held.splice(0).forEach((cb) => real(cb)); } };
+    })()""")
+    open_dashboard(page, server)
+    page.evaluate("window.__pad.connect()")
+    pad(page, axes=[0, -1], enable=True)
+    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == 5.0, timeout=5.0)
+    peer.clear("/cmd_vel")
+    t = time.monotonic()
+    page.evaluate("window.__raf.pause()")
+    assert_stops_soon(peer, t, "stalled reading")
+    page.evaluate("window.__raf.resume()")
+    page.wait_for_selector("#gamepad[data-state='blocked']", timeout=5000)
+    press_enable_again(page)
+    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == 5.0, timeout=5.0)
+    pad(page, enable=False)
+    peer.wait_for("/cmd_vel", is_zero, timeout=2.0)
+    assert page.watch.console_errors == []
+
+
 def test_axes_inversion_dead_zone_and_enable_button_are_set_on_the_card_and_kept(rig, page):
     server, peer = rig
     open_dashboard(page, server)
