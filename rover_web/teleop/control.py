@@ -225,9 +225,8 @@ class TeleopController:
                 raise Refused("not_in_control", f"{self._holder.name} holds control; you are view-only "
                               'until they release it or you send {"takeover": true}',
                               holder=self._holder.public())
-            if source != session.source:  # once per change, not per frame: the 40 Hz path stays as it was
-                session.source = source
-                log.info("teleop: %s drives with the %s", session.name, source)
+            new_source = source != session.source  # logged once per change, not per frame
+            session.source = source
             linear_mps, angular_rps = scale(linear, angular, self.limits)
             previous = self._command
             self._command = Command(linear_mps, angular_rps, source, session, now + self.deadman_s)
@@ -238,7 +237,9 @@ class TeleopController:
             self.stats["inputs"] += 1
             self._changed()
             self._cond.notify_all()
-            return linear_mps, angular_rps
+        if new_source:  # after the publish and outside the lock: the log's I/O never delays a command
+            log.info("teleop: %s drives with the %s", session.name, source)
+        return linear_mps, angular_rps
 
     def stop(self, session: Session, reason: str = "operator") -> bool:
         """The holder's own stop (stick released, key up, tab hidden). A viewer's stop is ignored."""
