@@ -42,7 +42,9 @@ log = logging.getLogger(__name__)
 REST_COMMANDS: dict[str, tuple[float, float]] = {
     "forward": (1.0, 0.0), "back": (-1.0, 0.0), "left": (0.0, 1.0), "right": (0.0, -1.0),
 }
-SOURCES = ("joystick", "keyboard")
+# Where a socket's drive frames come from: the page's own controls. The rules are the same for all;
+# the source is kept in the state (SSE `teleop`) and logged when a socket starts using another.
+SOURCES = ("joystick", "keyboard", "gamepad")
 
 
 @dataclass(frozen=True)
@@ -91,6 +93,7 @@ class Session:
     # False from an e-stop release until this socket sends a neutral input: a stick or key held
     # through the release must not move the robot the moment the latch opens.
     armed: bool = True
+    source: str | None = None  # of its last accepted drive frame, so only a change is logged
     outbox: deque = field(default_factory=lambda: deque(maxlen=64))
     wake: Callable[[], None] | None = None
 
@@ -102,7 +105,7 @@ class Session:
 class Command:
     linear_mps: float
     angular_rps: float
-    source: str                  # joystick | keyboard | rest
+    source: str                  # joystick | keyboard | gamepad | rest
     session: Session | None      # None for REST
     expires_at: float            # deadman deadline, or the end of a REST command's duration
 
@@ -197,7 +200,7 @@ class TeleopController:
 
     def drive(self, session: Session, linear: float, angular: float, *, epoch: int = 0,
               source: str = "joystick") -> tuple[float, float]:
-        """A joystick/keyboard input (fractions of the maxima). Published at once if it changed."""
+        """A joystick/keyboard/gamepad input (fractions of the maxima). Published at once if it changed."""
         with self._cond:
             now = self._clock()
             self._expire(now)  # a stalled server stops first, then judges the frames that piled up
@@ -222,6 +225,8 @@ class TeleopController:
                 raise Refused("not_in_control", f"{self._holder.name} holds control; you are view-only "
                               'until they release it or you send {"takeover": true}',
                               holder=self._holder.public())
+            new_source = source != session.source  # logged once per change, not per frame
+            session.source = source
             linear_mps, angular_rps = scale(linear, angular, self.limits)
             previous = self._command
             self._command = Command(linear_mps, angular_rps, source, session, now + self.deadman_s)
@@ -232,7 +237,9 @@ class TeleopController:
             self.stats["inputs"] += 1
             self._changed()
             self._cond.notify_all()
-            return linear_mps, angular_rps
+        if new_source:  # after the publish and outside the lock: the log's I/O never delays a command
+            log.info("teleop: %s drives with the %s", session.name, source)
+        return linear_mps, angular_rps
 
     def stop(self, session: Session, reason: str = "operator") -> bool:
         """The holder's own stop (stick released, key up, tab hidden). A viewer's stop is ignored."""

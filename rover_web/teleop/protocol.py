@@ -1,7 +1,7 @@
 """What a teleop WebSocket frame may say, parsed strictly. Pure Python.
 
 Client -> server, one JSON object per text frame:
-  {"linear": f, "angular": f, "epoch": n, "source": "joystick"|"keyboard"}   drive; f in [-1, 1]
+  {"linear": f, "angular": f, "epoch": n, "source": "joystick"|"keyboard"|"gamepad"}  drive; f in [-1, 1]
   {"stop": true}        the operator's own stop (stick released, key up, tab hidden)
   {"takeover": true}    take control from whoever holds it
   {"release": true}     give control back

@@ -1,4 +1,4 @@
-// The Drive panel: virtual joystick (nipplejs) and keyboard over the /ws/teleop WebSocket.
+// The Drive panel: virtual joystick (nipplejs), keyboard and gamepad over the /ws/teleop WebSocket.
 //
 // The server decides when the robot stops: it repeats the held command at its own rate and stops
 // it when this page falls silent for its deadman time. The page only says what the operator holds,
@@ -8,6 +8,7 @@
 // the robot again.
 import { on } from './live.js';
 import { operatorName, setOperatorName } from './operator.js';
+import { startGamepad } from './teleop_gamepad.js';
 import { setEstopSender } from './teleop_link.js';
 
 const card = document.getElementById('teleop-card');
@@ -34,6 +35,8 @@ function start() {
   let keySpeed = 0.5;
   let repeatTimer = null;
   let driving = false;         // a drive frame went out since the last stop
+  let sentAt = -Infinity;      // when the last drive frame went out (performance.now())
+  let periodMs = 25;           // the server's repeat period, 1 / rate_hz
 
   const clamp = (v) => (Number.isFinite(v) ? Math.max(-1, Math.min(1, v)) : 0);
   const round = (v) => Math.round(clamp(v) * 1000) / 1000;
@@ -46,6 +49,7 @@ function start() {
     card.dataset.mode = 'read-only';
     text('teleop-link', 'view only');
     message(card.dataset.readonlyReason || 'Driving needs the operator role.');
+    text('gamepad-name', 'view only');
     on('teleop', (s) => {
       text('teleop-linear', s.linear_mps.toFixed(2));
       text('teleop-angular', s.angular_rps.toFixed(2));
@@ -54,12 +58,17 @@ function start() {
     return;
   }
 
+  // Started before the socket: its command counts once the socket is open and this page may drive.
+  const gamepad = startGamepad({ onChange: () => update(), sentAt: () => sentAt });
+
   function send(obj) {
     if (ws && ws.readyState === WebSocket.OPEN) ws.send(JSON.stringify(obj));
   }
 
   function wanted() {
     if (stick) return { linear: stick.linear, angular: stick.angular, source: 'joystick' };
+    const pad = gamepad.command();
+    if (pad) return { linear: pad.linear, angular: pad.angular, source: 'gamepad' };
     if (keys.size) {
       const axis = (a, b) => (keys.has(a) ? 1 : 0) - (keys.has(b) ? 1 : 0);
       return { linear: keySpeed * axis('up', 'down'), angular: keySpeed * axis('left', 'right'), source: 'keyboard' };
@@ -74,11 +83,20 @@ function start() {
     if (!cmd || !mayDrive()) return;
     send({ linear: round(cmd.linear), angular: round(cmd.angular), epoch, source: cmd.source });
     driving = true;
+    sentAt = performance.now();
   }
 
   function stopRepeat() {
     clearInterval(repeatTimer);
     repeatTimer = null;
+  }
+
+  // The keep-alive: repeats what is held, unless a frame went out within the server's period
+  // anyway (a gamepad sends its changes at that rate), or says stop if what was held ended without
+  // telling update() (a gamepad reading that stalled).
+  function repeat() {
+    if (!wanted()) update();
+    else if (performance.now() - sentAt >= periodMs) sendDrive();
   }
 
   // Called whenever what the operator holds changes.
@@ -90,7 +108,7 @@ function start() {
       return;
     }
     sendDrive();
-    if (!repeatTimer) repeatTimer = setInterval(sendDrive, keepaliveMs);
+    if (!repeatTimer) repeatTimer = setInterval(repeat, keepaliveMs);
   }
 
   // Blur, hidden tab, pagehide, Space: forget everything held and tell the server at once.
@@ -98,6 +116,7 @@ function start() {
     if (stick) stickSuppressed = true;
     stick = null;
     keys.clear();
+    gamepad.suppress();
     stopRepeat();
     if (driving) send({ stop: true });
     driving = false;
@@ -118,6 +137,8 @@ function start() {
     if (m.type === 'hello') {
       session = m.session;
       keepaliveMs = Math.max(20, 1000 * m.keepalive_s);
+      periodMs = 1000 / m.rate_hz;
+      gamepad.setRate(m.rate_hz);
       retryMs = 500;
       const link = $('teleop-link');
       link.dataset.state = 'live';
@@ -132,12 +153,12 @@ function start() {
       else if (m.reason === 'taken_over' && !inControl) message('Another operator took control.');
       else if (m.reason === 'in_control') message('');
       else if (m.reason === 'estop_released') {
-        message(m.armed === false && wanted() ? 'E-stop released: release the stick (or keys) to re-arm.' : '');
+        message(m.armed === false && wanted() ? 'E-stop released: let go of the stick, keys or gamepad to re-arm.' : '');
       }
       render();
       if (wanted()) sendDrive();  // still held: the new epoch makes this a fresh, live input
     } else if (m.type === 'error' && m.error === 'rearm_required') {
-      message('E-stop released: release the stick (or keys) to re-arm.');
+      message('E-stop released: let go of the stick, keys or gamepad to re-arm.');
     } else if (m.type === 'error' && m.error !== 'stale_epoch') {
       message(m.message);
     }

@@ -354,3 +354,53 @@ def test_idle_stops_publish_nothing_but_explicit_stops_always_publish_zero(rig):
     assert out.sent[n:] == [(100.0, 0.0, 0.0)]
     ctl.engage_estop("x")
     assert out.sent[n + 1:] == [(100.0, 0.0, 0.0)]
+
+
+# --- the gamepad: one more source, under the same rules ---
+
+def test_a_gamepad_source_is_recorded_and_logged_once_per_change(rig, caplog):
+    ctl, clock, out, states = rig
+    a = ctl.connect("alice")
+    with caplog.at_level("INFO", logger="rover_web.teleop.control"):
+        ctl.drive(a, 0.5, 0, source="gamepad")
+        for _ in range(5):
+            clock.advance(0.025)
+            ctl.drive(a, 0.5, 0.1, source="gamepad")
+        ctl.drive(a, 0.5, 0.1, source="joystick")
+        ctl.drive(a, 0.5, 0.1, source="gamepad")
+    assert states[-1]["source"] == "gamepad" and out.last == (2.5, 0.2)
+    said = [r.getMessage() for r in caplog.records if r.name == "rover_web.teleop.control"]
+    assert said == ["teleop: alice drives with the gamepad", "teleop: alice drives with the joystick",
+                    "teleop: alice drives with the gamepad"]
+
+
+def test_a_gamepad_gets_the_deadman_clamps_single_operator_estop_and_rearm_unchanged(rig):
+    ctl, clock, out, states = rig
+    a, b = ctl.connect("a"), ctl.connect("b")
+    # Clamps: fractions scale by the maxima (values beyond [-1, 1] never reach here: protocol.py).
+    assert ctl.drive(a, 1, -1, source="gamepad") == (5.0, -2.0)
+    # Single operator: another socket's gamepad is refused while `a` holds control.
+    with pytest.raises(Refused) as info:
+        ctl.drive(b, 0.2, 0, source="gamepad")
+    assert info.value.code == "not_in_control"
+    # Deadman: silence stops the gamepad's command and bumps the epoch.
+    run_until(ctl, clock, clock.t + 0.35)
+    assert out.last == (0.0, 0.0) and a.epoch == 1 and states[-1]["last_stop"]["reason"] == "deadman"
+    with pytest.raises(Refused) as info:
+        ctl.drive(a, 1, 0, epoch=0, source="gamepad")
+    assert info.value.code == "stale_epoch"
+    # E-stop: refused while engaged; after the release a held stick must come back to neutral.
+    ctl.drive(a, 0.4, 0, epoch=a.epoch, source="gamepad")
+    ctl.engage_estop("b")
+    with pytest.raises(Refused) as info:
+        ctl.drive(a, 0.4, 0, epoch=a.epoch, source="gamepad")
+    assert info.value.code == "estop_engaged"
+    ctl.release_estop("b")
+    with pytest.raises(Refused) as info:
+        ctl.drive(a, 0.4, 0, epoch=a.epoch, source="gamepad")
+    assert info.value.code == "rearm_required"
+    ctl.drive(a, 0, 0, epoch=a.epoch, source="gamepad")
+    assert ctl.drive(a, 0.4, 0, epoch=a.epoch, source="gamepad") == (2.0, 0.0)
+    # Letting go of enable sends a stop: one zero, control kept.
+    ctl.stop(a)
+    assert out.last == (0.0, 0.0) and states[-1]["source"] is None and states[-1]["holder"]["name"] == "a"

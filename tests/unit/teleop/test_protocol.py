@@ -18,6 +18,8 @@ def test_drive_frames():
     assert parse_frame('{"linear": 0.5, "angular": -1}', MAX) == Drive(0.5, -1.0, 0, "joystick")
     assert parse_frame('{"linear": 0, "angular": 0, "epoch": 3, "source": "keyboard"}', MAX) == \
         Drive(0.0, 0.0, 3, "keyboard")
+    assert parse_frame('{"linear": -0.25, "angular": 1, "epoch": 2, "source": "gamepad"}', MAX) == \
+        Drive(-0.25, 1.0, 2, "gamepad")
 
 
 @pytest.mark.parametrize("action", ["stop", "takeover", "release"])
@@ -40,7 +42,8 @@ def test_control_frames(action):
     ('{"linear": 0, "angular": 0, "speed": 1}', "unknown_field"),
     ('{"linear": 0, "angular": 0, "epoch": -1}', "bad_type"),
     ('{"linear": 0, "angular": 0, "epoch": 1.5}', "bad_type"),
-    ('{"linear": 0, "angular": 0, "source": "gamepad"}', "bad_value"),
+    ('{"linear": 0, "angular": 0, "source": "joypad"}', "bad_value"),
+    ('{"linear": 0, "angular": 0, "source": "Gamepad"}', "bad_value"),
     ('{"stop": false}', "bad_value"),
     ('{"stop": true, "linear": 1}', "unknown_field"),
     ('[0.5, 0.5]', "bad_frame"),
@@ -91,7 +94,7 @@ frame_texts = st.one_of(
     st.dictionaries(frame_keys, json_values, max_size=5).map(json.dumps),
     st.fixed_dictionaries({"linear": json_numbers, "angular": json_numbers},
                           optional={"epoch": json_numbers,
-                                    "source": st.sampled_from(["joystick", "keyboard", "\ud800"])}
+                                    "source": st.sampled_from(["joystick", "keyboard", "gamepad", "\ud800"])}
                           ).map(json.dumps),
     json_values.map(json.dumps),
     st.tuples(st.sampled_from(['{"linear": %s, "angular": 0}', '{"epoch": %s, "linear": 0, "angular": 0}', '[%s]']),
