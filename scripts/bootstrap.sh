@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Install everything rover_web needs into .venv (and Debian's Chromium with --browser).
+# Install everything rover_web needs into .venv (and, with --browser, the Debian packages the
+# tests need: chromium for the browser tests, faketime for the wall-clock jump test).
 # Safe to run again: it only installs what is missing or changed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -32,10 +33,10 @@ if [[ ! -f "$stamp" || "$(cat "$stamp")" != "$digest" ]]; then
   echo "$digest" > "$stamp"
 fi
 
-if (( want_browser )) && [[ ! -x /usr/bin/chromium ]]; then
-  echo "== installing Debian's chromium for the browser tests"
+if (( want_browser )) && { [[ ! -x /usr/bin/chromium ]] || [[ ! -e /usr/lib/x86_64-linux-gnu/faketime/libfaketimeMT.so.1 ]]; }; then
+  echo "== installing Debian's chromium and faketime for the tests"
   sudo_cmd=()
   [[ $(id -u) -ne 0 ]] && sudo_cmd=(sudo)
   "${sudo_cmd[@]}" apt-get update -q
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -q chromium
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -q chromium faketime
 fi

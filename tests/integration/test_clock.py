@@ -1,0 +1,93 @@
+"""Deadman and stale times use a monotonic clock: a wall-clock jump of an hour changes nothing (issue 21).
+
+The server runs under libfaketime (Debian's `faketime`, installed by scripts/bootstrap.sh) with
+its monotonic clock left alone: the offset file moves the server's wall clock an hour forward and
+back while a joystick drives and the simulator's /odom keeps the link fresh.
+"""
+
+import ast
+import email.utils
+import time
+from pathlib import Path
+
+import pytest
+import requests
+
+import rover_web
+from tests.support.teleop_support import TeleopClient, drive_at, is_zero, subscribe_cmd_vel, twists, warm_up
+from tests.support.waiting import wait_until
+
+FAKETIME = Path("/usr/lib/x86_64-linux-gnu/faketime/libfaketimeMT.so.1")
+
+
+def server_wall_clock(url: str) -> float:
+    """The server's idea of the wall clock: its HTTP Date header."""
+    return email.utils.parsedate_to_datetime(requests.get(url + "/api/status", timeout=5).headers["Date"]).timestamp()
+
+
+def link(url: str) -> str:
+    return requests.get(url + "/api/status", timeout=5).json()["robot_link"]
+
+
+@pytest.mark.ros
+def test_a_wall_clock_jump_of_an_hour_changes_neither_the_deadman_nor_the_link(
+        server_process, sim_process, ros_peer, tmp_path):
+    if not FAKETIME.exists():
+        pytest.fail(f"{FAKETIME} is missing: scripts/bootstrap.sh installs Debian's faketime")
+    offset = tmp_path / "faketime"
+    offset.write_text("+0\n")
+    server = server_process(env={"LD_PRELOAD": str(FAKETIME), "FAKETIME_TIMESTAMP_FILE": str(offset),
+                                 "FAKETIME_NO_CACHE": "1", "FAKETIME_DONT_FAKE_MONOTONIC": "1"}).start()
+    sim_process("--only", "rover")
+    peer = ros_peer("clock_listener")
+    subscribe_cmd_vel(peer)
+    warm_up(peer, server.url)
+    wait_until(lambda: link(server.url) == "ok", 20, "the simulator's /odom makes the link ok")
+
+    client = TeleopClient(server.url)
+    deadman_s = client.hello["deadman_s"]
+    before = server_wall_clock(server.url)
+    drive_at(client, [(0.4, 0.0)] * 8)
+    offset.write_text("+3600\n")  # an hour forward, mid-drive
+    drive_at(client, [(0.4, 0.0)] * 40)  # 1 s more of fresh input
+    assert server_wall_clock(server.url) - before > 3500, "libfaketime did not move the server's wall clock"
+    # A wall-clock deadman would have found the last input an hour old and stopped the robot.
+    assert not any(lin == 0.0 for _, lin, _ in twists(peer)), "stopped while input was fresh"
+    assert link(server.url) == "ok"
+
+    peer.clear("/cmd_vel")
+    times = drive_at(client, [(0.5, 0.0)] * 8)
+    offset.write_text("-3600\n")  # and back, past where it started: the last input now looks an hour ahead
+    zero = peer.wait_for("/cmd_vel", is_zero, timeout=3.0)
+    assert zero["t"] - times[-1] <= deadman_s + 0.5, zero["t"] - times[-1]  # stopped by the deadman, not never
+    for _ in range(4):
+        assert link(server.url) == "ok"  # stale times are monotonic too
+        time.sleep(0.25)
+    client.close()
+
+
+# What measures an age or a deadline must not read the wall clock; records may (their timestamps).
+WALL_CLOCK_ALLOWED = {
+    "auth/accounts.py": "created_at and revoked_at of users and tokens",
+    "auth/tls.py": "certificate validity dates",
+    "estop/service.py": "`since` of the latch, shown to people and kept on disk",
+    "teleop/control.py": "times in the teleop state shown to people (deadman and rate use the monotonic clock)",
+    "scan_the_code/service.py": "when a code was seen, shown to people (cycles use the monotonic clock)",
+    "geofence/service.py": "`since` shown to people",
+    "geofence/store.py": "when the fence was saved",
+    "panels/oplog.py": "when a log line was written",
+    "waypoints/store.py": "created_at of a waypoint",
+}
+
+
+def test_only_records_read_the_wall_clock():
+    root = Path(rover_web.__file__).parent
+    readers = set()
+    for path in root.rglob("*.py"):
+        tree = ast.parse(path.read_text())
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Attribute) and node.attr in ("time", "now", "utcnow", "today") and \
+                    isinstance(node.value, (ast.Name, ast.Attribute)) and \
+                    getattr(node.value, "id", getattr(node.value, "attr", "")) in ("time", "datetime", "date"):
+                readers.add(str(path.relative_to(root)))
+    assert readers <= set(WALL_CLOCK_ALLOWED), sorted(readers - set(WALL_CLOCK_ALLOWED))
