@@ -83,7 +83,9 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
                                stamped=settings["ROVER_WEB_CMD_VEL_STAMPED"],
                                frame_id=settings["ROVER_WEB_CMD_VEL_FRAME_ID"])
         hub = EventHub(max_clients=settings["ROVER_WEB_SSE_MAX_CLIENTS"])
-        rover = Rover(settings, hub, runtime, cmd_vel, db=Database(db_path),
+        db = Database(db_path)
+        db.check()
+        rover = Rover(settings, hub, runtime, cmd_vel, db=db,
                       broadcaster=Broadcaster(hub, settings["ROVER_WEB_SSE_KEEPALIVE_S"]))
         rover.on_shutdown(db_claim.release)  # shutdown hooks run last first: after the database closes
         rover.on_shutdown(rover.db.close)

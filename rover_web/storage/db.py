@@ -97,6 +97,27 @@ class Database:
                 if statement.strip():
                     conn.execute(statement)
 
+    def check(self) -> None:
+        """At start: the file is a sound SQLite database this process can write, or a ConfigError
+        that says so and what to do (a traceback from the first request would say neither)."""
+        try:
+            conn = self.connection()
+            problems = [row[0] for row in conn.execute("PRAGMA quick_check").fetchall()]
+            if problems != ["ok"]:
+                raise ConfigError(f"the database {self.path} is damaged ({'; '.join(problems[:3])}); move it "
+                                  f"aside to start with an empty one, or restore a backup")
+            with self.transaction() as c:  # a write lock and nothing written: proves it can be written
+                c.execute("CREATE TABLE IF NOT EXISTS rover_web_write_check (id INTEGER)")
+                c.execute("DROP TABLE rover_web_write_check")
+        except sqlite3.Error as exc:
+            self.close()
+            if "readonly" in str(exc) or "read-only" in str(exc):
+                hint = "the server must be able to write it and its folder"
+            else:
+                hint = "it is not a SQLite database, or is damaged; move it aside to start with an empty one, " \
+                       "or restore a backup"
+            raise ConfigError(f"the database {self.path} cannot be used: {exc}; {hint}") from None
+
     def close(self) -> None:
         with self._lock:
             for conn in self._all:

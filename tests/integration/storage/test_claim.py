@@ -56,3 +56,37 @@ def test_a_database_path_that_cannot_be_made_is_a_clear_error_not_a_traceback(se
         server.start(timeout=20)
     assert f"rover_web: cannot use the database {blocker / 'db.sqlite3'}" in server.log()
     assert "Traceback" not in server.log()
+
+
+def test_a_corrupt_database_at_start_is_a_sentence_and_an_exit(server_process, tmp_path):
+    db = tmp_path / "corrupt.sqlite3"
+    db.write_bytes(os.urandom(16384))
+    server = server_process(env={"ROVER_WEB_DB_PATH": str(db)})
+    with pytest.raises(RuntimeError, match="server exited with"):
+        server.start(timeout=20)
+    assert f"rover_web: the database {db} cannot be used: file is not a database; it is not a SQLite " \
+        "database, or is damaged; move it aside" in server.log()
+    assert "Traceback" not in server.log()
+
+
+def test_a_read_only_database_at_start_is_a_sentence_and_an_exit(server_process, tmp_path):
+    """Root ignores file modes, so the file sits on a tmpfs remounted read-only."""
+    mount = tmp_path / "ro"
+    mount.mkdir()
+    made = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4m", "tmpfs", str(mount)], capture_output=True)
+    if made.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {made.stderr.decode().strip()}")
+    try:
+        db = mount / "robot.sqlite3"
+        first = server_process(env={"ROVER_WEB_DB_PATH": str(db)}).start()  # a real database, with tables
+        first.stop()
+        subprocess.run(["mount", "-o", "remount,ro", str(mount)], check=True)
+        server = server_process(env={"ROVER_WEB_DB_PATH": str(db)})
+        with pytest.raises(RuntimeError, match="server exited with"):
+            server.start(timeout=20)
+        assert f"rover_web: cannot claim the database {db}" in server.log() or \
+            f"rover_web: the database {db} cannot be used" in server.log(), server.log()[-800:]
+        assert "must be able to write" in server.log() or "writable folder" in server.log()
+        assert "Traceback" not in server.log()
+    finally:
+        subprocess.run(["umount", "-l", str(mount)], check=False)
