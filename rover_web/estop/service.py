@@ -101,7 +101,7 @@ class EStopService:
                 self._state = {"engaged": True, "since": self._clock(), "by": by, "via": via, "persisted": None,
                                "cancel": None}
             state = dict(self._state)
-        self._stop_everything(by, cancel_goals=first)
+        self._stop_everything(by, first=first)
         if not first:
             return self.state()
         log.warning("e-stop engaged by %s (%s)", by, via)
@@ -158,14 +158,18 @@ class EStopService:
 
     # --- internals ---
 
-    def _stop_everything(self, by: str, cancel_goals: bool) -> None:
-        # What needs no disk first; hooks last, since one may write a log entry.
+    def _stop_everything(self, by: str, first: bool) -> None:
+        # What needs no disk first; hooks last, since one may write a log entry. Pressed again
+        # while engaged, zero and the flag go out again, and nothing else: the hooks (a panel's
+        # Stop, its log line on disk) already ran, and a held or repeated press must stay fast.
         try:
             self._zero()
         except Exception:
             log.exception("e-stop: zero velocity could not be published")
         self._publish_flag_safely(True)
-        if cancel_goals and self._canceller is not None:
+        if not first:
+            return
+        if self._canceller is not None:
             self._canceller.cancel_all(self._goals_canceled)
         for hook in self._engage_hooks:
             self._run_hook(hook, by)
