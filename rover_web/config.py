@@ -177,6 +177,14 @@ SETTINGS: tuple[Setting, ...] = (
             "arrays and byte fields longer than this are shown cut, with their length", 1, 10000),
     Setting("TOPICS_ECHO_IDLE_TIMEOUT_S", 2.0, "float",
             "how long a topic browser subscription stays after its last viewer leaves", 0.0, 600),
+    # --- observability: /rosout, diagnostics, plots ---
+    Setting("ROSOUT_KEEP", 5000, "int", "/rosout lines kept in memory (oldest dropped)", 10, 1000000),
+    Setting("DIAGNOSTICS_STALE_S", 5.0, "float", "a diagnostic status older than this is stale",
+            0.1, 3600),
+    Setting("PLOT_KEEP_POINTS", 20000, "int", "samples kept per plotted series", 100, 1000000),
+    Setting("PLOT_IDLE_S", 30.0, "float",
+            "a plotted series ends this long after a page last asked for it",
+            1.0, 3600),
     # --- scan the code ---
     Setting("LIGHT_SEQUENCE_TOPIC", "/light_sequence", "topic",
             "std_msgs/String colour names from the light tower detector (Scan the Code)"),
