@@ -45,7 +45,7 @@ def _query(args) -> dict:
 def api_rosout():
     log = current_feature(RosoutLog)
     query = _query(request.args)
-    return jsonify({"lines": log.ring.query(**query), "kept": len(log.ring), "keep": log.ring.keep,
+    return jsonify({"lines": log.ring.query(**query), "keep": log.ring.keep,
                     **log.health()})
 
 

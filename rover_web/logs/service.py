@@ -32,7 +32,7 @@ class RosoutLog:
             self.rover.hub.emit("rosout", {"lines": lines, "skipped": skipped})
 
     def health(self) -> dict:
-        return {"errors_last_minute": self.ring.errors_last_minute(), "lines": len(self.ring)}
+        return {"errors_last_minute": self.ring.errors_last_minute(), "kept": len(self.ring)}
 
     def publish_health(self) -> None:
         """The health bar's error count, on `rosout_health`, only when it changed."""

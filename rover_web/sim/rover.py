@@ -149,6 +149,16 @@ class GoalFollower:
         return max(-limit, min(limit, value))
 
 
+# rclpy remembers each logging call site's severity and refuses another one there: one site per level.
+_LOG = {
+    "debug": lambda logger, text: logger.debug(text),
+    "info": lambda logger, text: logger.info(text),
+    "warning": lambda logger, text: logger.warning(text),
+    "error": lambda logger, text: logger.error(text),
+    "fatal": lambda logger, text: logger.fatal(text),
+}
+
+
 class RoverSim(Node):
     def __init__(self, *, context=None, x: float = 0.0, y: float = 0.0, yaw: float = 0.0,
                  stamped: bool = False, lat0: float = BENDERSON_LAT, lon0: float = BENDERSON_LON,
@@ -186,9 +196,8 @@ class RoverSim(Node):
                                                hardware_id=s["hardware_id"],
                                                values=[KeyValue(key=k, value=v) for k, v in s["values"].items()]))
         self.diag_pub.publish(msg)
-        logger = self.get_logger()
         for level, text in lines:
-            getattr(logger, level)(text)
+            _LOG[level](self.get_logger(), text)
 
     def _on_cmd(self, twist) -> None:
         if self.follower.cancel():

@@ -28,6 +28,16 @@ from rover_web.ros.typesupport import message_class
 
 out_lock = threading.Lock()
 
+# rclpy remembers each logging call site's severity and refuses another one there, so one call
+# site per level.
+LOG = {
+    "debug": lambda logger, text: logger.debug(text),
+    "info": lambda logger, text: logger.info(text),
+    "warning": lambda logger, text: logger.warning(text),
+    "error": lambda logger, text: logger.error(text),
+    "fatal": lambda logger, text: logger.fatal(text),
+}
+
 
 def profile(name):
     return qos.profile("default", depth=name) if isinstance(name, int) else qos.profile(name)
@@ -84,9 +94,9 @@ def main():
                 type_name, pub = pubs[cmd["topic"]]
                 pub.publish(dict_to_message(type_name, cmd.get("msg", {})))
             elif op == "log":
-                write = getattr(node.get_logger(), cmd.get("level", "info"))
+                write = LOG[cmd.get("level", "info")]
                 for _ in range(cmd.get("times", 1)):
-                    write(cmd["text"])
+                    write(node.get_logger(), cmd["text"])
             elif op == "unsub":
                 node.destroy_subscription(subs.pop(cmd["topic"]))
             elif op == "wait_match":
