@@ -63,7 +63,7 @@ async function reload() {
   const mine = ++loading;
   try {
     const reply = await api('GET', `/api/rosout?${query}`);
-    if (mine !== loading) return;  // a newer filter was typed meanwhile
+    if (mine !== loading || paused) return;  // a newer filter was typed meanwhile, or the table is frozen
     rows = reply.lines;
     $('log-error').hidden = true;
     render();
