@@ -37,7 +37,7 @@ def same_line(a: dict, b: dict) -> bool:
 
 
 class LogRing:
-    def __init__(self, keep: int, batch_max: int = 500, clock=time.monotonic):
+    def __init__(self, keep: int, batch_max: int = 250, clock=time.monotonic):
         self.keep = keep
         self._lines: deque[dict] = deque(maxlen=keep)
         self._errors: deque[float] = deque(maxlen=keep)  # receive times of ERROR and FATAL lines
@@ -65,6 +65,12 @@ class LogRing:
         with self._lock:
             return len(self._lines)
 
+    @property
+    def last_seq(self) -> int:
+        """The number of the newest line (lines are numbered 1, 2, ... as they arrive)."""
+        with self._lock:
+            return self._seq
+
     def drain(self) -> tuple[list[dict], int]:
         """(lines since the last drain, oldest first; how many more came than one batch holds)."""
         with self._lock:
@@ -82,8 +88,13 @@ class LogRing:
     def query(self, min_level: int = 0, node: str = "", contains: str = "", limit: int = 200) -> list[dict]:
         """Newest first: lines at or above `min_level`, from a node whose name contains `node`,
         whose text contains `contains` (both case-insensitive); repeats grouped; at most `limit` groups."""
+        return self.query_at(min_level, node, contains, limit)[0]
+
+    def query_at(self, min_level: int = 0, node: str = "", contains: str = "",
+                 limit: int = 200) -> tuple[list[dict], int]:
+        """query(), and the number of the newest line it saw (the page's place in the `rosout` channel)."""
         with self._lock:
-            lines = list(self._lines)
+            lines, last_seq = list(self._lines), self._seq
         node, contains = node.lower(), contains.lower()
         grouped: list[dict] = []
         for line in reversed(lines):
@@ -100,4 +111,4 @@ class LogRing:
             if len(grouped) >= limit:
                 break
             grouped.append({**line, "count": 1, "first_stamp": line["stamp"]})
-        return grouped
+        return grouped, last_seq

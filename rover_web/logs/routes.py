@@ -45,7 +45,8 @@ def _query(args) -> dict:
 def api_rosout():
     log = current_feature(RosoutLog)
     query = _query(request.args)
-    return jsonify({"lines": log.ring.query(**query), "keep": log.ring.keep,
+    lines, last_seq = log.ring.query_at(**query)
+    return jsonify({"lines": lines, "last_seq": last_seq, "keep": log.ring.keep, "received": log.received,
                     **log.health()})
 
 

@@ -26,10 +26,17 @@ class RosoutLog:
         self.ring.add(msgs.log_line(msg))
 
     def flush(self) -> None:
-        """Send what arrived since the last flush as one `rosout` event (in order, never conflated)."""
+        """Send what arrived since the last flush as one `rosout` value.
+
+        Published, not emitted: a log flood must not fill the hub's replay ring (it would hold 256
+        batches of lines and push every other channel's events out of it). A browser that misses
+        a batch (a slow socket, a reconnect) sees a gap in the line numbers and reads the ring
+        with GET /api/rosout instead.
+        """
         lines, skipped = self.ring.drain()
         if lines:
-            self.rover.hub.emit("rosout", {"lines": lines, "skipped": skipped})
+            self.rover.hub.publish("rosout", {"first_seq": lines[0]["seq"], "last_seq": lines[-1]["seq"] + skipped,
+                                              "lines": lines, "skipped": skipped})
 
     def health(self) -> dict:
         return {"errors_last_minute": self.ring.errors_last_minute(), "kept": len(self.ring)}

@@ -1,7 +1,8 @@
 // The /rosout log: the newest lines first, filtered by level (a minimum), node and text, repeats
 // grouped with a count. The first page comes from GET /api/rosout (which filters and groups on the
 // server); new lines arrive in batches on the `rosout` channel and are filtered and grouped here
-// the same way. Pause stops the table moving; resume reloads it from the server.
+// the same way; lines are numbered, so a missed batch is noticed and the table re-read. Pause
+// stops the table moving; resume reloads it from the server.
 import { api, ApiError } from './api.js';
 import { on } from './live.js';
 
@@ -15,6 +16,8 @@ const contains = $('log-contains');
 const pause = $('log-pause');
 
 let rows = [];  // grouped lines, newest first, as the server sends them
+let lastSeq = null;
+let catchingUp = false;  // a flood makes every batch a gap: one catch-up read at a time  // the newest line number this table has taken in (null: not loaded yet)
 let paused = false;
 let held = 0;
 let loading = 0;
@@ -65,6 +68,7 @@ async function reload() {
     const reply = await api('GET', `/api/rosout?${query}`);
     if (mine !== loading || paused) return;  // a newer filter was typed meanwhile, or the table is frozen
     rows = reply.lines;
+    lastSeq = reply.last_seq;
     $('log-error').hidden = true;
     render();
   } catch (err) {
@@ -75,8 +79,17 @@ async function reload() {
 
 on('rosout', (batch) => {
   if (paused) { held += batch.lines.length; render(); return; }
+  if (lastSeq === null || batch.last_seq <= lastSeq) return;  // loading, or already in the table
+  // A batch this page did not get (the channel keeps only the newest), or more lines than one
+  // batch holds: read the ring instead of showing a table with a hole in it.
+  if (batch.first_seq > lastSeq + 1 || batch.skipped) {
+    if (!catchingUp) { catchingUp = true; reload().finally(() => { catchingUp = false; }); }
+    return;
+  }
   const f = filters();
   for (const line of batch.lines) {  // oldest first
+    if (line.seq <= lastSeq) continue;
+    lastSeq = line.seq;
     if (!matches(line, f)) continue;
     if (rows.length && same(rows[0], line)) {
       rows[0] = { ...rows[0], count: rows[0].count + 1, stamp: line.stamp };
@@ -85,7 +98,6 @@ on('rosout', (batch) => {
     }
   }
   if (rows.length > SHOWN) rows.length = SHOWN;
-  if (batch.skipped) { reload(); return; }  // more came than one batch holds: read them from the ring
   render();
 });
 

@@ -46,6 +46,10 @@ def test_lines_logged_by_another_node_are_served_filtered_and_grouped(live_serve
     batched = batched()
     assert batched[:4] == ["starting up", "debug detail", "battery low", "motor fault"] and len(batched) == 9
     assert len([e for e in stream.of("rosout")]) < len(batched)
+    # Lines are numbered, batches run on without a hole, and the API says where the ring is.
+    events = [e["json"] for e in stream.of("rosout")]
+    assert all(b["first_seq"] == a["last_seq"] + 1 for a, b in zip(events, events[1:], strict=False))
+    assert rosout(live_server).json()["last_seq"] == events[-1]["last_seq"]
     # And the health bar counts the error.
     stream.wait_for("rosout_health", lambda h: h["errors_last_minute"] >= 1, timeout=5)
 
