@@ -22,5 +22,5 @@ def init_app(app, rover: Rover) -> None:
     rover.hub.register("plot")
     app.register_blueprint(routes.bp)
     rover.add_nav("Plot", "/plot")
-    rover.every(TICK_S, plots.tick, name="plot-tick")
+    rover.every(TICK_S, plots.tick, name="plot-tick", only_while=plots.plotting)
     rover.on_shutdown(plots.close)

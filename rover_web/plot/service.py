@@ -65,6 +65,7 @@ class Plots:
         self._topics: dict[tuple[str, str], _PlotTopic] = {}
         self._lock = threading.Lock()
         self.decode_errors = 0
+        self.plotting = threading.Event()  # the plot loop sleeps while nothing is plotted
 
     @property
     def browser(self) -> TopicBrowser:
@@ -91,6 +92,7 @@ class Plots:
                 plot_topic = self._topics[key] = _PlotTopic(key, echo)
                 echo.listeners = (*echo.listeners, plot_topic.put)
             series = plot_topic.series[field] = _Series(field, self.keep)
+            self.plotting.set()
             return series
 
     def tick(self) -> None:
@@ -146,6 +148,8 @@ class Plots:
                     del self._topics[key]
                     plot_topic.echo.listeners = tuple(f for f in plot_topic.echo.listeners if f != plot_topic.put)
                     released.append(key)
+            if not self._topics:
+                self.plotting.clear()
         for key in released:
             self.browser.release(key)
 
