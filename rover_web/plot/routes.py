@@ -8,6 +8,7 @@ import time
 from flask import Blueprint, jsonify, render_template, request
 
 from rover_web.core.state import current_feature
+from rover_web.topics.routes import STATUS as ECHO_STATUS
 from rover_web.topics.service import EchoRefused, TopicBrowser
 from rover_web.web.http import ApiError
 from rover_web.web.validate import InvalidInput
@@ -20,9 +21,12 @@ bp = Blueprint("plot", __name__)
 
 MAX_SECONDS = 24 * 3600.0
 DEFAULT_SECONDS = 60.0
-# The topic browser's refusals, as it answers them (routes.py of topics).
-ECHO_STATUS = {"unknown_topic": 404, "ambiguous_type": 409, "unknown_type": 422, "too_many_streams": 503,
-               "shutting_down": 503, "cannot_subscribe": 400}
+
+
+def _refused(exc: EchoRefused) -> ApiError:
+    """The topic browser's refusal, with the status the topic browser answers it with (its subclasses too)."""
+    status = next((ECHO_STATUS[cls] for cls in type(exc).__mro__ if cls in ECHO_STATUS), 503)
+    return ApiError(status, exc.code, str(exc))
 
 
 def _topic_key(args) -> tuple[str, str]:
@@ -31,7 +35,7 @@ def _topic_key(args) -> tuple[str, str]:
     except InvalidInput as exc:
         raise ApiError(400, exc.code, str(exc)) from None
     except EchoRefused as exc:
-        raise ApiError(ECHO_STATUS.get(exc.code, 400), exc.code, str(exc)) from None
+        raise _refused(exc) from None
 
 
 def _seconds(args) -> float:
@@ -62,7 +66,7 @@ def api_plot():
     except TooManySeries as exc:
         raise ApiError(503, "too_many_series", str(exc)) from None
     except EchoRefused as exc:
-        raise ApiError(ECHO_STATUS.get(exc.code, 400), exc.code, str(exc)) from None
+        raise _refused(exc) from None
     t, v, decimated = series.ring.window(time.time() - seconds)
     return jsonify({"id": series_id(key[0], field), "topic": key[0], "type": key[1], "field": field,
                     "seconds": seconds, "t": t, "v": v, "decimated": decimated,
