@@ -97,3 +97,22 @@ def test_bad_requests_are_refused_with_json(live_server, params, status, code):
     if code:
         assert reply.json()["error"] == code
     assert live_server.rover.feature(Plots).active() == []  # nothing started
+
+
+def test_plots_and_echoes_share_one_subscription_and_the_topic_browsers_cap(live_server_factory, ros_peer,
+                                                                            sse_client):
+    server = live_server_factory(ROVER_WEB_SSE_MAX_CLIENTS=2)  # also the topic browser's viewer cap
+    peer = ros_peer("shared_peer")
+    peer.advertise("/test/shared", ODOM)
+    peer.advertise("/test/other", ODOM)
+    wait_until(lambda: listed(server, "/test/shared") and listed(server, "/test/other"), 15, "topics listed")
+    assert plot(server, topic="/test/shared", field="twist.twist.linear.x").status_code == 200
+    echo = sse_client(server.url + "/api/topics/echo?topic=/test/shared")
+    echo.wait_for("stats", timeout=10)
+    echoes = server.rover.feature(TopicBrowser).echoes
+    key = ("/test/shared", ODOM)
+    assert len(echoes) == 1 and echoes.users(key) == 2  # the echo viewer and the plot: one subscription
+    # The plot counts as one of the topic browser's viewers: the cap of two is reached.
+    refused = plot(server, topic="/test/other", field="twist.twist.linear.x")
+    assert refused.status_code == 503 and refused.json()["error"] == "too_many_streams"
+    assert ("/test/other", ODOM) not in echoes
