@@ -58,7 +58,21 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         return app  # a CLI command, not a server: no node, no database, no stop-on-exit hooks
 
     require_rclpy()
-    from rover_web import camera, estop, geofence, livemap, panels, scan_the_code, telemetry, teleop, topics, waypoints
+    from rover_web import (
+        camera,
+        diagnostics,
+        estop,
+        geofence,
+        livemap,
+        logs,
+        panels,
+        plot,
+        scan_the_code,
+        telemetry,
+        teleop,
+        topics,
+        waypoints,
+    )
     from rover_web.core.state import EXTENSION, Rover
     from rover_web.events.broadcast import Broadcaster
     from rover_web.events.hub import EventHub
@@ -104,6 +118,9 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         livemap.init_app(app, rover)
         camera.init_app(app, rover)
         topics.init_app(app, rover)
+        logs.init_app(app, rover)
+        diagnostics.init_app(app, rover)
+        plot.init_app(app, rover)  # after topics: plots share its subscriptions
     except BaseException:
         # A feature that failed to start may follow others that already started loops and
         # threads: stop them all in order, not just the node under them.

@@ -199,6 +199,14 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("TOPICS_ECHO_MAX_SUBSCRIPTIONS", 16, "int",
             "most different topics (and types) echoed at once; viewers of the same one share it (503 beyond)",
             1, 1024),
+    # --- observability: /rosout, diagnostics, plots ---
+    Setting("ROSOUT_KEEP", 5000, "int", "/rosout lines kept in memory (oldest dropped)", 10, 1000000),
+    Setting("DIAGNOSTICS_STALE_S", 5.0, "float", "a diagnostic status older than this is stale",
+            0.1, 3600),
+    Setting("PLOT_KEEP_POINTS", 20000, "int", "samples kept per plotted series", 100, 1000000),
+    Setting("PLOT_IDLE_S", 30.0, "float",
+            "a plotted series ends this long after a page last asked for it",
+            1.0, 3600),
     # --- scan the code ---
     Setting("LIGHT_SEQUENCE_TOPIC", "/light_sequence", "topic",
             "std_msgs/String colour names from the light tower detector (Scan the Code)"),

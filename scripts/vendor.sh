@@ -19,11 +19,13 @@ set -euo pipefail
 
 NIPPLEJS_VERSION="0.10.2"
 MAPLIBRE_VERSION="5.24.1"
+UPLOT_VERSION="1.6.32"
 
 # sha256 of the npm tarballs (npm itself also checks the registry's sha512
 # integrity when it downloads them).
 NIPPLEJS_TGZ_SHA256="09f50689ef1169b2bf03c8f6263b10981cd5dc572bcbc007133e8ccdff0352a2"
 MAPLIBRE_TGZ_SHA256="b84d7fdf7fba5922fd3fff9a92733936c7a03b99165afc6c84f41c311bdbfa9d"
+UPLOT_TGZ_SHA256="4b8a8191e425658e3ea8c8c1314b0fc679c861ee3a1af2b20c7b16ba50b5133d"
 
 # "<path inside the package>  <name in static/vendor/...>  <sha256>"
 NIPPLEJS_FILES=(
@@ -34,6 +36,11 @@ MAPLIBRE_FILES=(
   "dist/maplibre-gl.js   maplibre-gl.js   a9c9e2aa36d4d5b63b131f27c1272f1a28883eeecc0eddd1e0dbfae4033bc7c9"
   "dist/maplibre-gl.css  maplibre-gl.css  ab1e70d59ec40465bae7e7030da2f3ccf28133fd502e62bd598eefbadfd7a732"
   "LICENSE.txt           LICENSE.txt      ee5fc05a0677eaf69601d2c7db0d9ecd6cc27c3abc1d0733bc9ed34707cf8ef2"
+)
+UPLOT_FILES=(
+  "dist/uPlot.iife.min.js  uPlot.iife.min.js  19c8d4c6ad88929a79f4ae49d6f7161566dfd0ba3d15cc495e974f787eb78f1f"
+  "dist/uPlot.min.css      uPlot.min.css      df630c6a8d6f8eeaff264b50f73ce5b114f646ffd9a0bb74f049b0a00135fa04"
+  "LICENSE                 LICENSE            8f989229699b4fe2f1a0432d0e9edc338a8a911e250e2d1b01ecd770a5f5b1bd"
 )
 
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -102,6 +109,7 @@ if [[ "${1:-}" == "--check" ]]; then
   rc=0
   verify_dir "$VENDOR_DIR/nipplejs-$NIPPLEJS_VERSION" "${NIPPLEJS_FILES[@]}" || rc=1
   verify_dir "$VENDOR_DIR/maplibre-gl-$MAPLIBRE_VERSION" "${MAPLIBRE_FILES[@]}" || rc=1
+  verify_dir "$VENDOR_DIR/uplot-$UPLOT_VERSION" "${UPLOT_FILES[@]}" || rc=1
   [[ $rc -eq 0 ]] && echo "vendor.sh: all vendored files match their pinned sha256"
   exit "$rc"
 elif [[ $# -gt 0 ]]; then
@@ -114,4 +122,5 @@ trap 'rm -rf "$TMP"' EXIT
 
 vendor_pkg nipplejs "$NIPPLEJS_VERSION" "$NIPPLEJS_TGZ_SHA256" "${NIPPLEJS_FILES[@]}"
 vendor_pkg maplibre-gl "$MAPLIBRE_VERSION" "$MAPLIBRE_TGZ_SHA256" "${MAPLIBRE_FILES[@]}"
+vendor_pkg uplot "$UPLOT_VERSION" "$UPLOT_TGZ_SHA256" "${UPLOT_FILES[@]}"
 echo "vendor.sh: done"

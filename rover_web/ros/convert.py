@@ -79,6 +79,8 @@ def _fill(msg: Any, data: dict[str, Any]) -> None:
                 _fill(child, item)
                 items.append(child)
             setattr(msg, name, items)
+        elif fields[name] in ("byte", "octet") and isinstance(value, int):
+            setattr(msg, name, bytes([value]))  # JSON has no bytes; rclpy wants b"\x01" for a ROS byte
         else:
             setattr(msg, name, value)
 

@@ -20,13 +20,17 @@ import sys
 import time
 from dataclasses import dataclass
 
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry, Path
+from rclpy.logging import LoggingSeverity
 from rclpy.node import Node
 from sensor_msgs.msg import NavSatFix, NavSatStatus
 
 from rover_web.ros import qos
 from rover_web.ros.convert import quaternion_from_yaw, yaw_from_quaternion
+
+from .health import HealthModel
 
 EARTH_RADIUS_M = 6378137.0
 BENDERSON_LAT = 27.3742443
@@ -145,6 +149,16 @@ class GoalFollower:
         return max(-limit, min(limit, value))
 
 
+# rclpy remembers each logging call site's severity and refuses another one there: one site per level.
+_LOG = {
+    "debug": lambda logger, text: logger.debug(text),
+    "info": lambda logger, text: logger.info(text),
+    "warning": lambda logger, text: logger.warning(text),
+    "error": lambda logger, text: logger.error(text),
+    "fatal": lambda logger, text: logger.fatal(text),
+}
+
+
 class RoverSim(Node):
     def __init__(self, *, context=None, x: float = 0.0, y: float = 0.0, yaw: float = 0.0,
                  stamped: bool = False, lat0: float = BENDERSON_LAT, lon0: float = BENDERSON_LON,
@@ -166,6 +180,24 @@ class RoverSim(Node):
         self._ticks = 0
         self._last = time.monotonic()
         self.create_timer(self._dt, self._tick)
+        # Diagnostics and log lines at every level, once a second, so the demo's /diagnostics and
+        # /logs show something (rclpy nodes log to /rosout).
+        self.health = HealthModel()
+        self.diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
+        self.get_logger().set_level(LoggingSeverity.DEBUG)
+        self.create_timer(1.0, self._health)
+
+    def _health(self) -> None:
+        statuses, lines = self.health.step()
+        msg = DiagnosticArray()
+        msg.header.stamp = self.get_clock().now().to_msg()
+        for s in statuses:
+            msg.status.append(DiagnosticStatus(level=bytes([s["level"]]), name=s["name"], message=s["message"],
+                                               hardware_id=s["hardware_id"],
+                                               values=[KeyValue(key=k, value=v) for k, v in s["values"].items()]))
+        self.diag_pub.publish(msg)
+        for level, text in lines:
+            _LOG[level](self.get_logger(), text)
 
     def _on_cmd(self, twist) -> None:
         if self.follower.cancel():

@@ -99,10 +99,15 @@ class TopicEcho:
         self._sample: tuple[int, dict | None, str | None] = (0, None, None)  # seq, message, error
         self._decoded_at = -float("inf")
         self._closed = False
+        # Callables given every serialized message (the plots: rover_web/plot/). Replaced, never
+        # mutated, so put() reads it without a lock.
+        self.listeners: tuple[Callable[[bytes], None], ...] = ()
 
     def put(self, serialized: bytes) -> None:
         """From the ROS callback: count it, keep it, wake the viewers. No decoding here."""
         self.meter.record(len(serialized))
+        for listener in self.listeners:
+            listener(serialized)
         with self._cond:
             self._raw = serialized
             self._raw_seq += 1

@@ -41,6 +41,12 @@ def build_status(rover: Rover) -> dict:
     }
 
 
+@bp.get("/api/ping")
+def ping():
+    """The smallest answer, for the browser to time its round trip to the server (the link plot)."""
+    return jsonify({"t": round(time.time(), 4)})
+
+
 @bp.get("/api/status")
 def status():
     return jsonify(build_status(current_rover()))

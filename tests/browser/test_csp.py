@@ -10,7 +10,8 @@ from tests.conftest import PageWatch
 
 pytestmark = pytest.mark.browser
 
-PAGES = ["/", "/livemap", "/topics", "/panels", "/waypoints"]
+PAGES = ["/", "/livemap", "/topics", "/panels", "/waypoints", "/logs", "/diagnostics",
+         "/plot?topic=/odom&field=twist.twist.linear.x"]
 
 
 def test_no_page_breaks_the_content_security_policy(live_server, browser, sim_process):
@@ -25,6 +26,9 @@ def test_no_page_breaks_the_content_security_policy(live_server, browser, sim_pr
             if path == "/":
                 page.wait_for_selector(".maplibregl-canvas", timeout=10000)  # its worker comes from blob:
                 page.wait_for_selector("#teleop-link[data-state='live']", timeout=10000)
+                page.wait_for_selector("#link-plot canvas", timeout=10000)  # uPlot draws under the policy
+            if path.startswith("/plot"):
+                page.wait_for_selector("#plot-chart canvas", timeout=10000)
         refused = [m for m in watch.console_errors if "Content Security Policy" in m or "Refused to" in m]
         assert refused == [], refused
         assert watch.console_errors == [], watch.console_errors

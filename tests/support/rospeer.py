@@ -99,6 +99,10 @@ class RosPeer:
     def publish(self, topic: str, msg: dict) -> None:
         self._call(op="send", topic=topic, msg=msg)
 
+    def log(self, text: str, level: str = "info", times: int = 1) -> None:
+        """Log `text` through the peer node's own logger (to /rosout), `times` times in a row."""
+        self._call(op="log", level=level, text=text, times=times)
+
     def wait_match(self, topic: str, count: int = 1, timeout: float = 10.0) -> None:
         """Block until the peer's publisher or subscription on `topic` sees `count` counterparts."""
         self._call(reply_timeout=timeout + 5, op="wait_match", topic=topic, count=count, timeout=timeout)

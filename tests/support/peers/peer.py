@@ -3,6 +3,8 @@
 Commands (stdin):  {"op": "sub"|"pub", "topic", "type", "qos"}  {"op": "send", "topic", "msg"}
                    ("qos": a profile name, or an int: reliable, volatile, keep-last of that depth)
                    {"op": "wait_match", "topic", "count", "timeout"}  {"op": "quit"}
+                   {"op": "log", "level": "debug"|"info"|"warning"|"error"|"fatal", "text", "times"}
+                   (through the node's own logger, so the lines reach /rosout as any node's do)
                    {"op": "graph", "count": [topics]} -> ack with nodes, topics, pub/sub counts
 Events (stdout):   {"event": "ready"}  {"event": "ack", "op"}  {"event": "error", "message"}
                    {"event": "msg", "topic", "t": <CLOCK_MONOTONIC seconds>, "msg": {...}}
@@ -17,6 +19,7 @@ import time
 import rclpy
 from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.logging import LoggingSeverity
 from rclpy.signals import SignalHandlerOptions
 
 from rover_web.ros import qos
@@ -24,6 +27,16 @@ from rover_web.ros.convert import dict_to_message, message_to_dict
 from rover_web.ros.typesupport import message_class
 
 out_lock = threading.Lock()
+
+# rclpy remembers each logging call site's severity and refuses another one there, so one call
+# site per level.
+LOG = {
+    "debug": lambda logger, text: logger.debug(text),
+    "info": lambda logger, text: logger.info(text),
+    "warning": lambda logger, text: logger.warning(text),
+    "error": lambda logger, text: logger.error(text),
+    "fatal": lambda logger, text: logger.fatal(text),
+}
 
 
 def profile(name):
@@ -41,6 +54,7 @@ def main():
     context = Context()
     rclpy.init(context=context, signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node(sys.argv[1] if len(sys.argv) > 1 else "test_peer", context=context)
+    node.get_logger().set_level(LoggingSeverity.DEBUG)
     # Single-threaded: the multi-threaded executor busy-spins and delivers late under load.
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
@@ -79,6 +93,10 @@ def main():
             elif op == "send":
                 type_name, pub = pubs[cmd["topic"]]
                 pub.publish(dict_to_message(type_name, cmd.get("msg", {})))
+            elif op == "log":
+                write = LOG[cmd.get("level", "info")]
+                for _ in range(cmd.get("times", 1)):
+                    write(node.get_logger(), cmd["text"])
             elif op == "unsub":
                 node.destroy_subscription(subs.pop(cmd["topic"]))
             elif op == "wait_match":

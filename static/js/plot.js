@@ -1,0 +1,182 @@
+// Live plots: the operator adds (topic, field) series; each starts with its recent history from
+// GET /api/plot and then grows from the `plot` channel (new points of every series, ten times a
+// second). All series share one time axis (uPlot.join aligns them). Pause freezes the chart, a
+// drag zooms (and pauses), CSV exports every point this page holds.
+import { api, ApiError } from './api.js';
+import { on } from './live.js';
+
+const KEEP = 20000;  // points per series kept in the page
+const COLOURS = ['#58a6ff', '#e3b341', '#7ee787', '#ff7b72', '#d2a8ff', '#79c0ff', '#ffa657', '#a5d6ff'];
+const $ = (id) => document.getElementById(id);
+const chartEl = $('plot-chart');
+const topicSelect = $('plot-topic');
+const fieldInput = $('plot-field');
+const pauseButton = $('plot-pause');
+const idleS = Number($('plot').dataset.idleS || 30);
+
+const series = new Map();  // id -> {topic, field, t: [], v: []}
+let chart = null;
+let paused = false;
+let drawPending = false;
+
+function showError(err) {
+  const el = $('plot-error');
+  if (!err) { el.hidden = true; return; }
+  el.textContent = err instanceof ApiError ? err.message : 'the server was not reached';
+  el.hidden = false;
+}
+
+const windowS = () => Number($('plot-window').value);
+
+function tables(since) {
+  return [...series.values()].map((s) => {
+    let i = 0;
+    while (i < s.t.length && s.t[i] < since) i++;
+    return [s.t.slice(i), s.v.slice(i)];
+  });
+}
+
+function setPaused(value) {
+  paused = value;
+  pauseButton.setAttribute('aria-pressed', String(paused));
+  pauseButton.textContent = paused ? 'Resume' : 'Pause';
+  $('plot-state').textContent = paused ? 'paused' : 'live';
+  if (!paused) rebuild();
+}
+
+function rebuild() {
+  if (chart) { chart.destroy(); chart = null; }
+  chartEl.replaceChildren();
+  if (!series.size) { chartEl.dataset.points = '0'; return; }
+  const opts = {
+    width: Math.max(320, chartEl.clientWidth), height: 420,
+    series: [{}, ...[...series.keys()].map((id, i) => ({ label: id, stroke: COLOURS[i % COLOURS.length], spanGaps: true }))],
+    axes: [{ stroke: '#8b949e' }, { stroke: '#8b949e', size: 60 }],
+    hooks: { setSelect: [(u) => { if (u.select.width > 0) setPaused(true); }] },
+  };
+  chart = new window.uPlot(opts, data(), chartEl);
+}
+
+function data() {
+  const now = Date.now() / 1000;
+  const joined = window.uPlot.join(tables(now - windowS()));
+  chartEl.dataset.points = String(joined[0].length);
+  return joined;
+}
+
+function draw() {
+  drawPending = false;
+  if (paused || !chart) return;
+  chart.setData(data());
+}
+
+function scheduleDraw() {
+  if (!drawPending) { drawPending = true; requestAnimationFrame(draw); }
+}
+
+function renderList() {
+  $('plot-series').replaceChildren(...[...series.keys()].map((id) => {
+    const li = document.createElement('li');
+    li.dataset.series = id;
+    li.append(id);
+    const remove = document.createElement('button');
+    remove.type = 'button';
+    remove.textContent = '×';
+    remove.title = `remove ${id}`;
+    remove.addEventListener('click', () => { series.delete(id); renderList(); rebuild(); });
+    li.append(remove);
+    return li;
+  }));
+}
+
+function query(topic, field, seconds) {
+  return new URLSearchParams({ topic, field, seconds: String(seconds) });
+}
+
+async function add(topic, field) {
+  const reply = await api('GET', `/api/plot?${query(topic, field, windowS())}`);
+  if (!series.has(reply.id)) {
+    series.set(reply.id, { topic, field, t: reply.t, v: reply.v });
+    renderList();
+    rebuild();
+  }
+}
+
+on('plot', (event) => {
+  for (const [id, points] of Object.entries(event.series)) {
+    const s = series.get(id);
+    if (!s) continue;
+    const last = s.t.length ? s.t[s.t.length - 1] : -Infinity;
+    points.t.forEach((t, i) => { if (t > last) { s.t.push(t); s.v.push(points.v[i]); } });
+    if (s.t.length > KEEP) { s.t.splice(0, s.t.length - KEEP); s.v.splice(0, s.v.length - KEEP); }
+  }
+  scheduleDraw();
+});
+
+function csv() {
+  const joined = window.uPlot.join(tables(-Infinity));
+  const quote = (text) => `"${text.replaceAll('"', '""')}"`;
+  const lines = [['time_unix_s', ...[...series.keys()].map(quote)].join(',')];
+  for (let i = 0; i < joined[0].length; i++) {
+    lines.push(joined.map((column) => (column[i] === null || column[i] === undefined ? '' : column[i])).join(','));
+  }
+  return `${lines.join('\n')}\n`;
+}
+
+$('plot-csv').addEventListener('click', () => {
+  const url = URL.createObjectURL(new Blob([csv()], { type: 'text/csv' }));
+  const a = document.createElement('a');
+  a.href = url;
+  a.download = `rover_web-plot-${new Date().toISOString().replaceAll(':', '-')}.csv`;
+  document.body.append(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(url), 1000);
+});
+
+async function loadFields() {
+  $('plot-fields').replaceChildren();
+  if (!topicSelect.value) return;
+  try {
+    const reply = await api('GET', `/api/plot/fields?${new URLSearchParams({ topic: topicSelect.value })}`);
+    $('plot-fields').replaceChildren(...reply.fields.map((f) => Object.assign(document.createElement('option'), { value: f })));
+    showError(null);
+  } catch (err) { showError(err); }
+}
+
+topicSelect.addEventListener('change', loadFields);
+$('plot-form').addEventListener('submit', async (e) => {
+  e.preventDefault();
+  const topic = topicSelect.value;
+  const field = fieldInput.value.trim();
+  if (!topic || !field) { showError(new ApiError(400, 'missing', 'choose a topic and a field')); return; }
+  try { await add(topic, field); showError(null); } catch (err) { showError(err); }
+});
+pauseButton.addEventListener('click', () => setPaused(!paused));
+$('plot-window').addEventListener('change', () => { if (!paused) rebuild(); });
+
+on('topics', (graph) => {
+  const chosen = topicSelect.value;
+  const options = graph.topics.filter((t) => t.types.length === 1).map((t) => {
+    const o = document.createElement('option');
+    o.value = t.name;
+    o.textContent = `${t.name} (${t.types[0]})`;
+    return o;
+  });
+  topicSelect.replaceChildren(Object.assign(document.createElement('option'), { value: '', textContent: 'choose a topic' }),
+    ...options);
+  topicSelect.value = chosen;
+});
+
+// The server ends a series nobody asked for in idle_s; an open page keeps its series alive.
+setInterval(() => {
+  for (const s of series.values()) api('GET', `/api/plot?${query(s.topic, s.field, 1)}`).catch(() => {});
+}, (idleS * 1000) / 3);
+window.addEventListener('resize', () => { if (chart) chart.setSize({ width: Math.max(320, chartEl.clientWidth), height: 420 }); });
+
+// /plot?topic=/odom&field=twist.twist.linear.x opens with that series.
+const params = new URLSearchParams(location.search);
+for (const field of params.getAll('field')) {
+  const topic = params.get('topic');
+  if (topic) add(topic, field).catch(showError);
+}
