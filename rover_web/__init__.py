@@ -58,7 +58,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         return app  # a CLI command, not a server: no node, no database, no stop-on-exit hooks
 
     require_rclpy()
-    from rover_web import camera, estop, livemap, panels, scan_the_code, telemetry, teleop, topics, waypoints
+    from rover_web import apidocs, camera, estop, livemap, panels, scan_the_code, telemetry, teleop, topics, waypoints
     from rover_web.core.state import EXTENSION, Rover
     from rover_web.events.broadcast import Broadcaster
     from rover_web.events.hub import EventHub
@@ -104,6 +104,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     app.register_blueprint(pages.bp)
     app.register_blueprint(status.bp)
     app.register_blueprint(sse.bp)
+    apidocs.init_app(app, rover)  # after every route: it describes them all (docs/api.md)
     runtime.start()
     status.start_reporter(rover)
     if not app.testing:
