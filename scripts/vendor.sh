@@ -19,11 +19,13 @@ set -euo pipefail
 
 NIPPLEJS_VERSION="0.10.2"
 MAPLIBRE_VERSION="5.24.1"
+SWAGGER_UI_VERSION="5.35.0"
 
 # sha256 of the npm tarballs (npm itself also checks the registry's sha512
 # integrity when it downloads them).
 NIPPLEJS_TGZ_SHA256="09f50689ef1169b2bf03c8f6263b10981cd5dc572bcbc007133e8ccdff0352a2"
 MAPLIBRE_TGZ_SHA256="b84d7fdf7fba5922fd3fff9a92733936c7a03b99165afc6c84f41c311bdbfa9d"
+SWAGGER_UI_TGZ_SHA256="1b8e891893404ea4c3558b6a87e2a3e494e7eedba41168c2ece5800a391a6ea6"
 
 # "<path inside the package>  <name in static/vendor/...>  <sha256>"
 NIPPLEJS_FILES=(
@@ -34,6 +36,12 @@ MAPLIBRE_FILES=(
   "dist/maplibre-gl.js   maplibre-gl.js   a9c9e2aa36d4d5b63b131f27c1272f1a28883eeecc0eddd1e0dbfae4033bc7c9"
   "dist/maplibre-gl.css  maplibre-gl.css  ab1e70d59ec40465bae7e7030da2f3ccf28133fd502e62bd598eefbadfd7a732"
   "LICENSE.txt           LICENSE.txt      ee5fc05a0677eaf69601d2c7db0d9ecd6cc27c3abc1d0733bc9ed34707cf8ef2"
+)
+SWAGGER_UI_FILES=(
+  "swagger-ui-bundle.js  swagger-ui-bundle.js  e6a898692f2d768e807c3ba4626068a69a2c5dd960dd6c76f3e4d3a3de180af2"
+  "swagger-ui.css        swagger-ui.css        5ed08757e53da3e026d6cbecc61fe5d43585c9560b302d534ad56692519a273d"
+  "LICENSE               LICENSE               cfc7749b96f63bd31c3c42b5c471bf756814053e847c10f3eb003417bc523d30"
+  "NOTICE                NOTICE                0d20d1adef18aee3f40dd258172155521ce702ac445cb5f7b7d60ed32dad2fb2"
 )
 
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -102,6 +110,7 @@ if [[ "${1:-}" == "--check" ]]; then
   rc=0
   verify_dir "$VENDOR_DIR/nipplejs-$NIPPLEJS_VERSION" "${NIPPLEJS_FILES[@]}" || rc=1
   verify_dir "$VENDOR_DIR/maplibre-gl-$MAPLIBRE_VERSION" "${MAPLIBRE_FILES[@]}" || rc=1
+  verify_dir "$VENDOR_DIR/swagger-ui-dist-$SWAGGER_UI_VERSION" "${SWAGGER_UI_FILES[@]}" || rc=1
   [[ $rc -eq 0 ]] && echo "vendor.sh: all vendored files match their pinned sha256"
   exit "$rc"
 elif [[ $# -gt 0 ]]; then
@@ -114,4 +123,5 @@ trap 'rm -rf "$TMP"' EXIT
 
 vendor_pkg nipplejs "$NIPPLEJS_VERSION" "$NIPPLEJS_TGZ_SHA256" "${NIPPLEJS_FILES[@]}"
 vendor_pkg maplibre-gl "$MAPLIBRE_VERSION" "$MAPLIBRE_TGZ_SHA256" "${MAPLIBRE_FILES[@]}"
+vendor_pkg swagger-ui-dist "$SWAGGER_UI_VERSION" "$SWAGGER_UI_TGZ_SHA256" "${SWAGGER_UI_FILES[@]}"
 echo "vendor.sh: done"
