@@ -44,12 +44,19 @@ def header(name: str, schema: dict, description: str = "") -> dict:
 def op(summary: str, *, tag: str, ok: dict | None = None, status: int = 200, media: str = JSON,
        body: dict | None = None, body_required: bool = True, form: dict | None = None,
        params: list[dict] | tuple = (), errors: dict[int, str] | None = None, public: bool = False,
-       role: str = "viewer", description: str = "", extra: dict[str, Any] | None = None) -> dict:
+       role: str = "viewer", description: str = "", fuzz: str = "yes", fuzz_why: str = "",
+       extra: dict[str, Any] | None = None) -> dict:
     """One operation. `errors` maps each 4xx/5xx status the view itself may answer to its error codes.
 
     `role` is the least role the route needs when sign-in is on (rover_web/auth/policy.py decides;
-    this only documents it); `public` routes need no sign-in at all.
+    this only documents it); `public` routes need no sign-in at all. `fuzz` tells the fuzz test
+    (tests/integration/apidocs/test_fuzz.py) what to do: "yes", "last" (a second phase, for calls
+    that would stop the rest from being tested) or "skip", each but "yes" with `fuzz_why`.
     """
+    if (extra or {}).get("x-stream") and fuzz == "yes":
+        fuzz, fuzz_why = "skip", "an endless response; its query checks have their own tests"
+    if fuzz != "yes" and not fuzz_why:
+        raise ValueError(f"{summary!r}: say why it is fuzzed {fuzz!r} (fuzz_why)")
     responses: dict[str, Any] = {str(status): {"description": "success",
                                                "content": {media: {"schema": ok if ok is not None else {}}}}}
     all_errors = dict(GUARD_ERRORS)
@@ -58,7 +65,9 @@ def op(summary: str, *, tag: str, ok: dict | None = None, status: int = 200, med
     for code, codes in sorted(all_errors.items()):
         responses[str(code)] = {"description": codes, "content": {JSON: {"schema": ERROR_REF}}}
     operation: dict[str, Any] = {"summary": summary, "tags": [tag], "responses": responses,
-                                 "x-role": None if public else role}
+                                 "x-role": None if public else role, "x-fuzz": fuzz}
+    if fuzz_why:
+        operation["x-fuzz-why"] = fuzz_why
     if description:
         operation["description"] = description
     if params:

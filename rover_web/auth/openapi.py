@@ -4,6 +4,7 @@ from rover_web.apidocs.describe import obj, op, page, query
 
 ROLE = {"type": "string", "enum": ["viewer", "operator", "admin"]}
 USER = obj({"name": {"type": "string"}, "role": ROLE}, closed=False)
+LOSES = "could take the fuzz's own access away; its own user and token are kept out of reach too"
 ACCOUNT_400 = ("missing_body, bad_json, non_finite, unknown_field, missing_field, bad_type, too_long, "
                "bad_name, bad_role, weak_password")
 
@@ -36,10 +37,10 @@ PATHS = {
     "/api/users/{name}": {
         "patch": op("Change a user's role or password", tag="auth", role="admin", ok=USER,
                     body=obj({"role": ROLE, "password": {"type": "string", "maxLength": 1024}}, minProperties=1),
-                    errors={400: ACCOUNT_400 + ", last_admin", 404: "no_such_user"}),
+                    errors={400: ACCOUNT_400 + ", last_admin", 404: "no_such_user"}, fuzz="last", fuzz_why=LOSES),
         "delete": op("Remove a user and their tokens", tag="auth", role="admin",
                      ok=obj({"removed": {"type": "string"}}),
-                     errors={400: "last_admin", 404: "no_such_user"}),
+                     errors={400: "last_admin", 404: "no_such_user"}, fuzz="last", fuzz_why=LOSES),
     },
     "/api/tokens": {
         "get": op("Every API token (without its secret)", tag="auth", role="admin",
@@ -53,6 +54,6 @@ PATHS = {
     },
     "/api/tokens/{token_id}": {
         "delete": op("Revoke an API token", tag="auth", role="admin", ok=obj({"revoked": {"type": "integer"}}),
-                     errors={404: "no_such_token"}),
+                     errors={404: "no_such_token"}, fuzz="last", fuzz_why=LOSES),
     },
 }

@@ -15,6 +15,7 @@ PATHS = {
             errors={400: "missing_body, bad_json, non_finite, unknown_field, missing_field, bad_type",
                     403: "forbidden (releasing needs an operator)",
                     409: "release refused (see docs/estop.md)"},
-            description="`{\"engaged\": true}` always engages, whatever else the body holds."),
+            description="`{\"engaged\": true}` always engages, whatever else the body holds.",
+            fuzz="last", fuzz_why="engaged, it turns every motion route into a 409 for the rest of the run"),
     },
 }
