@@ -18,7 +18,6 @@ import sys
 import pytest
 import requests
 
-from rover_web.config import ROOT
 from tests.support.auth import add_users
 from tests.support.finite_watch import FiniteWatch
 from tests.support.rospeer import subprocess_env
@@ -41,7 +40,8 @@ def real_path_values(url: str, headers: dict) -> dict[str, list]:
             "control_id": sorted({c["id"] for p in panels for c in p["controls"]} | {"lock", "unlock"})}
 
 
-def schemathesis_run(url: str, token: str, token_id: int, selection: str, seed: int) -> subprocess.CompletedProcess:
+def schemathesis_run(url: str, token: str, token_id: int, selection: str, seed: int,
+                     workdir) -> subprocess.CompletedProcess:
     cmd = [sys.executable, "-m", "schemathesis.cli", "run", f"{url}/api/openapi.json",
            "--include-by", f"/x-fuzz == {selection}",
            "--checks", "not_a_server_error",
@@ -53,7 +53,8 @@ def schemathesis_run(url: str, token: str, token_id: int, selection: str, seed: 
     env = subprocess_env(SCHEMATHESIS_HOOKS="tests.support.fuzz_hooks", FUZZ_KEEP_USER="admin",
                          FUZZ_KEEP_TOKEN_ID=str(token_id), NO_COLOR="1", COLUMNS="200",
                          FUZZ_REAL_PATH_VALUES=json.dumps(real_path_values(url, {"Authorization": f"Bearer {token}"})))
-    run = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
+    # In the test's folder: Schemathesis keeps a cache (.schemathesis/) where it runs.
+    run = subprocess.run(cmd, cwd=workdir, env=env, capture_output=True, text=True, timeout=600)
     print(f"--- schemathesis, x-fuzz {selection} ---\n{run.stdout}\n{run.stderr}")  # shown when the test fails
     return run
 
@@ -72,7 +73,7 @@ def test_fuzzing_every_operation_finds_no_5xx_no_nan_and_a_sound_database(server
                                 timeout=5).json()
         selected = {selection: sum(op["x-fuzz"] == selection for item in document["paths"].values()
                                    for op in item.values()) for selection in ("yes", "last")}
-        runs = [schemathesis_run(server.url, token, token_id, selection, SEED)
+        runs = [schemathesis_run(server.url, token, token_id, selection, SEED, tmp_path)
                 for selection in ("yes", "last")]
         # The fuzz still had its access at the end, so the second phase was tested as the first.
         me = requests.get(server.url + "/api/me", headers={"Authorization": f"Bearer {token}"}, timeout=5)
