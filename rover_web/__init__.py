@@ -59,6 +59,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
 
     require_rclpy()
     from rover_web import (
+        apidocs,
         camera,
         diagnostics,
         estop,
@@ -133,6 +134,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     app.register_blueprint(pages.bp)
     app.register_blueprint(status.bp)
     app.register_blueprint(sse.bp)
+    apidocs.init_app(app, rover)  # after every route: it describes them all (docs/api.md)
     runtime.start()
     status.start_reporter(rover)
     if not app.testing:

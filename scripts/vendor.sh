@@ -20,12 +20,14 @@ set -euo pipefail
 NIPPLEJS_VERSION="0.10.2"
 MAPLIBRE_VERSION="5.24.1"
 UPLOT_VERSION="1.6.32"
+SWAGGER_UI_VERSION="5.35.0"
 
 # sha256 of the npm tarballs (npm itself also checks the registry's sha512
 # integrity when it downloads them).
 NIPPLEJS_TGZ_SHA256="09f50689ef1169b2bf03c8f6263b10981cd5dc572bcbc007133e8ccdff0352a2"
 MAPLIBRE_TGZ_SHA256="b84d7fdf7fba5922fd3fff9a92733936c7a03b99165afc6c84f41c311bdbfa9d"
 UPLOT_TGZ_SHA256="4b8a8191e425658e3ea8c8c1314b0fc679c861ee3a1af2b20c7b16ba50b5133d"
+SWAGGER_UI_TGZ_SHA256="1b8e891893404ea4c3558b6a87e2a3e494e7eedba41168c2ece5800a391a6ea6"
 
 # "<path inside the package>  <name in static/vendor/...>  <sha256>"
 NIPPLEJS_FILES=(
@@ -41,6 +43,12 @@ UPLOT_FILES=(
   "dist/uPlot.iife.min.js  uPlot.iife.min.js  19c8d4c6ad88929a79f4ae49d6f7161566dfd0ba3d15cc495e974f787eb78f1f"
   "dist/uPlot.min.css      uPlot.min.css      df630c6a8d6f8eeaff264b50f73ce5b114f646ffd9a0bb74f049b0a00135fa04"
   "LICENSE                 LICENSE            8f989229699b4fe2f1a0432d0e9edc338a8a911e250e2d1b01ecd770a5f5b1bd"
+)
+SWAGGER_UI_FILES=(
+  "swagger-ui-bundle.js  swagger-ui-bundle.js  e6a898692f2d768e807c3ba4626068a69a2c5dd960dd6c76f3e4d3a3de180af2"
+  "swagger-ui.css        swagger-ui.css        5ed08757e53da3e026d6cbecc61fe5d43585c9560b302d534ad56692519a273d"
+  "LICENSE               LICENSE               cfc7749b96f63bd31c3c42b5c471bf756814053e847c10f3eb003417bc523d30"
+  "NOTICE                NOTICE                0d20d1adef18aee3f40dd258172155521ce702ac445cb5f7b7d60ed32dad2fb2"
 )
 
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -110,6 +118,7 @@ if [[ "${1:-}" == "--check" ]]; then
   verify_dir "$VENDOR_DIR/nipplejs-$NIPPLEJS_VERSION" "${NIPPLEJS_FILES[@]}" || rc=1
   verify_dir "$VENDOR_DIR/maplibre-gl-$MAPLIBRE_VERSION" "${MAPLIBRE_FILES[@]}" || rc=1
   verify_dir "$VENDOR_DIR/uplot-$UPLOT_VERSION" "${UPLOT_FILES[@]}" || rc=1
+  verify_dir "$VENDOR_DIR/swagger-ui-dist-$SWAGGER_UI_VERSION" "${SWAGGER_UI_FILES[@]}" || rc=1
   [[ $rc -eq 0 ]] && echo "vendor.sh: all vendored files match their pinned sha256"
   exit "$rc"
 elif [[ $# -gt 0 ]]; then
@@ -123,4 +132,5 @@ trap 'rm -rf "$TMP"' EXIT
 vendor_pkg nipplejs "$NIPPLEJS_VERSION" "$NIPPLEJS_TGZ_SHA256" "${NIPPLEJS_FILES[@]}"
 vendor_pkg maplibre-gl "$MAPLIBRE_VERSION" "$MAPLIBRE_TGZ_SHA256" "${MAPLIBRE_FILES[@]}"
 vendor_pkg uplot "$UPLOT_VERSION" "$UPLOT_TGZ_SHA256" "${UPLOT_FILES[@]}"
+vendor_pkg swagger-ui-dist "$SWAGGER_UI_VERSION" "$SWAGGER_UI_TGZ_SHA256" "${SWAGGER_UI_FILES[@]}"
 echo "vendor.sh: done"

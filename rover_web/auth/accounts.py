@@ -25,6 +25,7 @@ NAME_PATTERN = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.@-]{0,39}\Z")
 MIN_PASSWORD_LEN = 8
 MAX_PASSWORD_LEN = 1024  # argon2 takes any length; a megabyte "password" would only cost CPU
 TOKEN_PREFIX = "rwt_"
+SQLITE_MAX_INT = (1 << 63) - 1  # the largest id a row can have
 
 ACCOUNTS_DDL = """
 CREATE TABLE IF NOT EXISTS auth_users (
@@ -189,6 +190,8 @@ class Accounts:
         return [dict(row) for row in rows]
 
     def revoke_token(self, token_id: int) -> None:
+        if not 0 <= token_id <= SQLITE_MAX_INT:  # SQLite cannot even compare a larger integer
+            raise AccountError(f"no token with id {str(token_id)[:30]}", "no_such_token")
         with self._db.transaction() as conn:
             row = conn.execute("SELECT revoked_at FROM auth_tokens WHERE id = ?", (token_id,)).fetchone()
             if row is None:

@@ -3,7 +3,7 @@ check every request passes before its view runs."""
 
 from __future__ import annotations
 
-from flask import Blueprint, jsonify, redirect, render_template, request, url_for
+from flask import Blueprint, jsonify, make_response, redirect, render_template, request, url_for
 from flask_login import current_user, login_user, logout_user
 
 from rover_web.core.state import current_feature
@@ -102,7 +102,8 @@ def _login_refused(as_json: bool, status: int, code: str, message: str, username
     if as_json:
         return error_response(status, code, message)
     html = render_template("login.html", next=next_path, error=message, username=username)
-    return html, status, {"Content-Type": "text/html; charset=utf-8"}
+    # A Response, not a (body, status, headers) tuple: the caller may add headers (Retry-After).
+    return make_response(html, status, {"Content-Type": "text/html; charset=utf-8"})
 
 
 @bp.post("/logout")

@@ -110,3 +110,11 @@ def test_the_schema_refuses_a_role_the_code_does_not_know(accounts, db):
     with pytest.raises(sqlite3.IntegrityError):
         with db.transaction() as conn:
             conn.execute("INSERT INTO auth_users VALUES ('eve', 'root', 'x', 0)")
+
+
+def test_revoking_a_token_id_beyond_sqlite_integers_is_no_such_token_not_an_overflow(accounts):
+    """Found by the fuzz (docs/api.md): DELETE /api/tokens/<26 digits> was a 500 (OverflowError)."""
+    for token_id in (1 << 63, 10**25):
+        with pytest.raises(AccountError) as refused:
+            accounts.revoke_token(token_id)
+        assert refused.value.code == "no_such_token"

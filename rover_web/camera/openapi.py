@@ -1,0 +1,33 @@
+"""Camera routes, for GET /api/openapi.json (see rover_web/apidocs/describe.py)."""
+
+from rover_web.apidocs.describe import obj, op, query
+
+PARAMS = [
+    query("topic", {"type": "string", "minLength": 1}, "the image topic, e.g. /camera/image_raw", required=True),
+    query("width", {"type": "integer", "minimum": 1}, "scale to this width (keeps the aspect without height)"),
+    query("height", {"type": "integer", "minimum": 1}, "scale to this height"),
+    query("quality", {"type": "integer", "minimum": 1, "maximum": 100}, "JPEG quality"),
+    query("qos_profile", {"type": "string", "enum": ["default", "sensor_data", "system_default"]},
+          "the subscription's QoS (default: as the publishers)"),
+    query("type", {"type": "string"}, "mjpeg (the only stream type), or a message type as msg_type"),
+    query("msg_type", {"type": "string", "examples": ["sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage"]},
+          "the message type, to wait for a topic not up yet"),
+]
+BAD = ("missing_topic, bad_topic, bad_value, out_of_range, unsupported_stream_type, type_mismatch, "
+       "not_an_image_topic, unknown_type")
+
+PATHS = {
+    "/stream": {
+        "get": op("An MJPEG stream of an image topic", tag="camera", media="multipart/x-mixed-replace",
+                  ok={"type": "string"}, params=PARAMS,
+                  errors={400: BAD, 404: "unknown_topic", 503: "too_many_viewers, too_many_streams, shutting_down"},
+                  extra={"x-stream": "mjpeg"}),
+    },
+    "/snapshot": {
+        "get": op("One JPEG from an image topic", tag="camera", media="image/jpeg",
+                  ok={"type": "string", "contentMediaType": "image/jpeg"}, params=PARAMS,
+                  errors={400: BAD, 404: "unknown_topic", 415: "an image the server cannot decode",
+                          503: "too_many_viewers, shutting_down", 504: "no_frame"}),
+    },
+    "/api/camera/streams": {"get": op("The open camera streams and viewers", tag="camera", ok=obj(closed=False))},
+}

@@ -1,0 +1,21 @@
+"""The e-stop's routes, for GET /api/openapi.json (see rover_web/apidocs/describe.py)."""
+
+from rover_web.apidocs.describe import obj, op
+
+STATE = obj({"engaged": {"type": "boolean"}, "cancellable_actions": {"type": "array"}}, closed=False)
+
+PATHS = {
+    "/api/estop": {
+        "get": op("The e-stop latch and who set it", tag="estop", ok=STATE),
+        "post": op(
+            "Engage (anyone signed in) or release (an operator) the e-stop", tag="estop", ok=STATE,
+            body=obj({"engaged": {"type": "boolean"},
+                      "by": {"type": ["string", "null"], "maxLength": 40,
+                             "description": "who, when sign-in is off"}}, ("engaged",)),
+            errors={400: "missing_body, bad_json, non_finite, unknown_field, missing_field, bad_type",
+                    403: "forbidden (releasing needs an operator)",
+                    409: "release refused (see docs/estop.md)"},
+            description="`{\"engaged\": true}` always engages, whatever else the body holds.",
+            fuzz="last", fuzz_why="engaged, it turns every motion route into a 409 for the rest of the run"),
+    },
+}

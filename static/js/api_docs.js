@@ -1,0 +1,10 @@
+// /api/docs: Swagger UI (vendored, window.SwaggerUIBundle) renders the app's own description.
+const root = document.getElementById("swagger-ui");
+
+window.SwaggerUIBundle({
+  url: root.dataset.specUrl,
+  domNode: root,
+  validatorUrl: null, // never send the document to validator.swagger.io: the robot may be offline
+  deepLinking: true,
+  tryItOutEnabled: false, // calls that move the robot should be deliberate, not one click away
+});
