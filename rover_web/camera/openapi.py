@@ -20,14 +20,16 @@ PATHS = {
     "/stream": {
         "get": op("An MJPEG stream of an image topic", tag="camera", media="multipart/x-mixed-replace",
                   ok={"type": "string"}, params=PARAMS,
-                  errors={400: BAD, 404: "unknown_topic", 503: "too_many_viewers, too_many_streams, shutting_down"},
+                  errors={400: BAD, 404: "unknown_topic",
+                          503: "too_many_viewers, too_many_producers, too_many_streams, shutting_down"},
                   extra={"x-stream": "mjpeg"}),
     },
     "/snapshot": {
         "get": op("One JPEG from an image topic", tag="camera", media="image/jpeg",
                   ok={"type": "string", "contentMediaType": "image/jpeg"}, params=PARAMS,
                   errors={400: BAD, 404: "unknown_topic", 415: "an image the server cannot decode",
-                          503: "too_many_viewers, shutting_down", 504: "no_frame"}),
+                          429: "rate_limited (CAMERA_SNAPSHOTS_PER_MIN; Retry-After)",
+                          503: "too_many_viewers, too_many_producers, shutting_down", 504: "no_frame"}),
     },
     "/api/camera/streams": {"get": op("The open camera streams and viewers", tag="camera", ok=obj(closed=False))},
 }

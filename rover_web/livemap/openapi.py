@@ -25,6 +25,7 @@ PATHS = {
                    body=obj({"x": {"type": "number"}, "y": {"type": "number"}, "yaw": {"type": "number"}},
                             ("x", "y")),
                    errors={400: "missing_body, bad_json, non_finite, unknown_field, missing_field, bad_type, "
-                                "outside_map", **UNKNOWN, 409: "estop_engaged", 503: "shutting_down"}),
+                                "outside_map", **UNKNOWN, 409: "estop_engaged",
+                           422: "outside_geofence (reason inside_keep_out)", 503: "shutting_down"}),
     },
 }

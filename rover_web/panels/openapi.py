@@ -17,7 +17,8 @@ PATHS = {
     },
     "/api/panels/{panel_id}/unlock": {
         "post": op("Unlock the panel for commands", tag="panels", role="operator", ok=VIEW,
-                   body=obj(closed=False), body_required=False, errors={400: "bad_json", **UNKNOWN}),
+                   body=obj(closed=False), body_required=False,
+                   errors={400: "bad_json", **UNKNOWN, 429: "rate_limited (PANEL_UNLOCKS_PER_MIN; Retry-After)"}),
     },
     "/api/panels/{panel_id}/lock": {
         "post": op("Lock the panel", tag="panels", role="operator", ok=VIEW,
@@ -27,6 +28,7 @@ PATHS = {
         "post": op("Run one of the panel's controls (its arguments in the body)", tag="panels", role="operator",
                    ok=obj(closed=False), body=obj(closed=False), body_required=False,
                    errors={400: "bad_json and the control's own argument errors", 404: "unknown_panel, unknown_control",
-                           409: "locked, estop_engaged and other refusals (docs/panels.md)"}),
+                           409: "locked, estop_engaged and other refusals (docs/panels.md)",
+                           429: "rate_limited (PANEL_REFUSALS_PER_MIN; Retry-After)"}),
     },
 }
