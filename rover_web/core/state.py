@@ -61,6 +61,7 @@ class Rover:
         self.nav_links: list[tuple[str, str]] = [("Dashboard", "/")]
         self._features: dict[type, object] = {}
         self._loops: list[Loop] = []
+        self.link_lost_hooks: list[Callable[[], None]] = []
         self._shutdown_hooks: list[Callable[[], None]] = []
         self._stopping = threading.Event()
 
@@ -102,6 +103,10 @@ class Rover:
                      only_while=only_while)
         self._loops.append(loop)
         return loop
+
+    def on_link_lost(self, hook: Callable[[], None]) -> None:
+        """Called (on the status loop) when the robot's link goes from fresh to stale."""
+        self.link_lost_hooks.append(hook)
 
     def on_shutdown(self, hook: Callable[[], None]) -> None:
         """Feature clean-up (threads, databases) that runs after motion is stopped."""

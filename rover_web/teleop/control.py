@@ -210,8 +210,8 @@ class TeleopController:
                               '{"engaged": false}) before driving')
             if not session.armed:
                 if linear or angular:
-                    raise Refused("rearm_required", "the e-stop was released while this input was held: "
-                                  "release the stick (or key) to re-arm, then drive")
+                    raise Refused("rearm_required", f"the robot was stopped ({self._last_stop_reason()}) while "
+                                  "this input was held: release the stick (or key) to re-arm, then drive")
                 session.armed = True
             if epoch != session.epoch:
                 self.stats["stale_dropped"] += 1
@@ -297,6 +297,18 @@ class TeleopController:
             self._stop("estop", bump=list(self._sessions.values()), always=True)
             self._changed()
             return dict(self._estop)
+
+    def link_lost(self) -> None:
+        """The robot's link went stale: stop what is held, and make every socket return to neutral
+        before it drives again (as after an e-stop), so a robot that comes back does not take up a
+        command the operator gave before it vanished."""
+        with self._cond:
+            held = self._command is not None
+            for session in self._sessions.values():
+                session.armed = False
+            self._stop("link_lost", bump=list(self._sessions.values()))
+            if held:
+                self._changed()
 
     def release_estop(self, by: str) -> dict:
         with self._cond:

@@ -35,6 +35,7 @@ class TeleopService:
         # without a call out of its lock, and re-arms its sockets on release.
         estop.on_engage(self.controller.engage_estop)
         estop.on_release(self.controller.release_estop)
+        rover.on_link_lost(self.controller.link_lost)
         self.repeater = Repeater(self.controller)
         self.max_frame_bytes = config["ROVER_WEB_TELEOP_MAX_FRAME_BYTES"]
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import time
 
 from flask import Blueprint, jsonify
@@ -9,6 +10,7 @@ from flask import Blueprint, jsonify
 from rover_web.core.state import Rover, current_rover
 
 bp = Blueprint("status", __name__)
+log = logging.getLogger(__name__)
 
 
 def link_state(topics: list[dict], link_topics: list[str]) -> str:
@@ -53,8 +55,23 @@ def status():
 
 
 def start_reporter(rover: Rover) -> None:
-    """Publish the status every STATUS_PERIOD_S; it is also the pages' heartbeat."""
+    """Publish the status every STATUS_PERIOD_S; it is also the pages' heartbeat. When the robot's
+    link goes from fresh to stale (its process died, the radio dropped), the link-lost hooks run:
+    teleop stops what it holds, so a robot that comes back does not resume an old command."""
     rover.hub.register("status")
-    rover.hub.publish("status", build_status(rover))
-    rover.every(rover.config["ROVER_WEB_STATUS_PERIOD_S"], lambda: rover.hub.publish("status", build_status(rover)),
-                name="status-reporter")
+    last = {"link": None}
+
+    def report() -> None:
+        status = build_status(rover)
+        rover.hub.publish("status", status)
+        link, before = status["robot_link"], last["link"]
+        last["link"] = link
+        if link == "stale" and before in ("ok", "degraded"):
+            for hook in rover.link_lost_hooks:
+                try:
+                    hook()
+                except Exception:
+                    log.exception("a link-lost hook failed")
+
+    report()
+    rover.every(rover.config["ROVER_WEB_STATUS_PERIOD_S"], report, name="status-reporter")

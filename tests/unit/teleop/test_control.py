@@ -218,6 +218,32 @@ def test_an_input_held_through_a_release_does_not_drive_until_released_and_press
     assert ctl.drive(a, 0.5, 0, epoch=a.epoch) == (2.5, 0.0)
 
 
+def test_a_lost_link_stops_the_held_command_and_needs_a_neutral_input_to_drive_again(rig):
+    """The robot's process died mid-drive: when it comes back, the stick held all along must not
+    resume; the operator lets go and drives again."""
+    ctl, clock, out, states = rig
+    a = ctl.connect("a")
+    ctl.drive(a, 1, 0)
+    epoch = a.epoch
+    ctl.link_lost()
+    assert out.last == (0.0, 0.0) and a.epoch == epoch + 1
+    assert a.outbox[-1]["reason"] == "link_lost" and a.outbox[-1]["armed"] is False
+    run_until(ctl, clock, clock.t + 1.0)
+    assert out.last == (0.0, 0.0)  # nothing repeats after the stop
+    with pytest.raises(Refused) as info:
+        ctl.drive(a, 1, 0, epoch=a.epoch)
+    assert info.value.code == "rearm_required" and "link_lost" in info.value.message
+    ctl.drive(a, 0, 0, epoch=a.epoch)
+    assert ctl.drive(a, 0.5, 0, epoch=a.epoch) == (2.5, 0.0)
+
+
+def test_a_lost_link_with_nothing_held_publishes_nothing(rig):
+    ctl, clock, out, states = rig
+    ctl.connect("a")
+    ctl.link_lost()
+    assert out.sent == []  # an idle GUI must not send zeros that would interrupt an autonomous goal
+
+
 def test_a_socket_that_connects_after_the_release_is_armed(rig):
     ctl, clock, out, states = rig
     ctl.engage_estop("b")
