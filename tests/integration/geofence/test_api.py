@@ -51,6 +51,7 @@ def test_the_fence_survives_a_restart(app_factory, tmp_path):
     db = str(tmp_path / "kept.sqlite3")
     first = app_factory(ROVER_WEB_DB_PATH=db)
     first.test_client().put("/api/geofence", json=FENCE)
+    first.extensions["rover_web"].shutdown()  # one server per database: the next one is a restart
     again = app_factory(ROVER_WEB_DB_PATH=db).test_client()
     fence = again.get("/api/geofence").get_json()
     assert fence["revision"] == 1 and len(fence["features"]) == 2
@@ -140,9 +141,11 @@ def test_the_geofence_file_seeds_only_an_empty_database(app_factory, tmp_path):
     path = tmp_path / "fence.geojson"
     path.write_text(json.dumps(FENCE))
     db = str(tmp_path / "seeded.sqlite3")
-    first = app_factory(ROVER_WEB_DB_PATH=db, ROVER_WEB_GEOFENCE_FILE=str(path)).test_client()
+    first_app = app_factory(ROVER_WEB_DB_PATH=db, ROVER_WEB_GEOFENCE_FILE=str(path))
+    first = first_app.test_client()
     assert first.get("/api/geofence").get_json()["revision"] == 1
     first.put("/api/geofence", json=collection())
+    first_app.extensions["rover_web"].shutdown()
     again = app_factory(ROVER_WEB_DB_PATH=db, ROVER_WEB_GEOFENCE_FILE=str(path)).test_client()
     assert again.get("/api/geofence").get_json() == {"type": "FeatureCollection", "features": [], "revision": 2}
 
