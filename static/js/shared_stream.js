@@ -29,7 +29,7 @@ const NAME = 'rover_web-sse';
 // Channels the server puts in its ring (hub.emit) instead of conflating: every event counts, so a
 // tab that joins is not handed an old one as if it were new. tests/unit/events/test_ring_channels.py
 // checks this against the server's code.
-export const RING_CHANNELS = new Set(['scan_code', 'panel_log']);
+export const RING_CHANNELS = new Set(['scan_code', 'panel_log', 'plot']);
 const HEARTBEAT_MS = 1000;
 const DEAD_AFTER_MS = 3000;  // plus up to 1.5 s at random, so followers do not all steal at once
 const FORGET_AFTER_BEATS = 5;  // a follower that answered none of the last heartbeats is gone
