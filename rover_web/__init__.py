@@ -58,7 +58,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         return app  # a CLI command, not a server: no node, no database, no stop-on-exit hooks
 
     require_rclpy()
-    from rover_web import camera, estop, livemap, panels, scan_the_code, telemetry, teleop, topics, waypoints
+    from rover_web import camera, estop, livemap, panels, ros_admin, scan_the_code, telemetry, teleop, topics, waypoints
     from rover_web.core.state import EXTENSION, Rover
     from rover_web.events.broadcast import Broadcaster
     from rover_web.events.hub import EventHub
@@ -101,6 +101,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         livemap.init_app(app, rover)
         camera.init_app(app, rover)
         topics.init_app(app, rover)
+        ros_admin.init_app(app, rover)
     except BaseException:
         # A feature that failed to start may follow others that already started loops and
         # threads: stop them all in order, not just the node under them.
