@@ -235,8 +235,8 @@ class AdminNode:
         """Send a goal; (goal_id, handle) once accepted, None if rejected, NoAnswer if no server.
         The callbacks run on the admin executor with plain values."""
         client = self._client("action", action_cls, action)
-        if not client.wait_for_server(timeout_sec=min(timeout_s, 2.0)):
-            raise NoAnswer(f"no action server for {action} answered within {min(timeout_s, 2.0):g} s")
+        if not client.wait_for_server(timeout_sec=timeout_s):
+            raise NoAnswer(f"no action server for {action} answered within {timeout_s:g} s")
 
         def feedback(msg) -> None:
             on_feedback(message_to_dict(msg.feedback, 64))
