@@ -14,7 +14,8 @@ def put(client, name, value):
 
 def test_parameters_are_listed_with_types_values_and_descriptors(client, admin_peer):
     params = wait_for_parameters(client)
-    assert {n: (p["type"], p["value"]) for n, p in params.items() if n not in ("use_sim_time", "start_type_description_service")} == {
+    builtin = ("use_sim_time", "start_type_description_service")
+    assert {n: (p["type"], p["value"]) for n, p in params.items() if n not in builtin} == {
         "flag": ("bool", True), "count": ("integer", 3), "gain": ("double", 0.5), "label": ("string", "hello"),
         "ids": ("integer_array", [1, 2, 3]), "weights": ("double_array", [0.5, 1.5]),
         "names": ("string_array", ["a", "b"]), "flags": ("bool_array", [True, False]),

@@ -3,7 +3,8 @@
     python action_server.py /navigate_to_pose
 
 Goals of order 1000 and more run until canceled (one step every 50 ms); a smaller order finishes
-after that many steps, with the Fibonacci sequence so far as feedback and the whole as result. Lines on stdout, JSON: {"event": "ready"},
+after that many steps, with the Fibonacci sequence so far as feedback and the whole as result.
+Lines on stdout, JSON: {"event": "ready"},
 {"event": "accepted", "t": ...}, {"event": "canceled", "t": ...} (t: CLOCK_MONOTONIC seconds).
 On stdin, "goal" sends one goal to this very server (through an ActionClient), "quit" ends.
 """

@@ -30,7 +30,8 @@ def test_every_basic_type_is_built():
 
 @pytest.mark.parametrize("field,value,code", [
     ("int8_value", 128, "out_of_range"), ("int8_value", -129, "out_of_range"), ("uint8_value", -1, "out_of_range"),
-    ("uint64_value", 2**64, "out_of_range"), ("int64_value", 2**63, "out_of_range"), ("byte_value", 256, "out_of_range"),
+    ("uint64_value", 2**64, "out_of_range"), ("int64_value", 2**63, "out_of_range"),
+    ("byte_value", 256, "out_of_range"),
     ("int32_value", 1.5, "bad_type"), ("int32_value", True, "bad_type"), ("int32_value", "1", "bad_type"),
     ("bool_value", 1, "bad_type"), ("bool_value", None, "bad_type"),
     ("float64_value", math.nan, "non_finite"), ("float64_value", math.inf, "non_finite"),
