@@ -153,6 +153,10 @@ def api_goal_events(goal_id: str):
         try:
             snap = tracked.snapshot()
             yield f"retry: {rover.config['ROVER_WEB_SSE_RETRY_MS']}\n\n".encode() + _event("status", snap)
+            if snap["result"] is not None:  # finished before the stream opened
+                yield _event("result", {"goal_id": snap["goal_id"], "status": snap["status"],
+                                        "result": snap["result"]})
+                return
             seq, feedback_seq, status = snap["seq"], snap["feedback_seq"], snap["status"]
             last_write = time.monotonic()
             while snap["result"] is None and not stopping.is_set():
