@@ -10,7 +10,7 @@ from tests.conftest import PageWatch
 
 pytestmark = pytest.mark.browser
 
-PAGES = ["/", "/livemap", "/topics", "/panels", "/waypoints"]
+PAGES = ["/", "/livemap", "/topics", "/panels", "/waypoints", "/ros"]
 
 
 def test_no_page_breaks_the_content_security_policy(live_server, browser, sim_process):
