@@ -11,10 +11,11 @@ import logging
 from typing import Any
 
 from rover_web.core.state import Rover
+from rover_web.estop import EStopEngaged
 from rover_web.panels.oplog import OperatorLog
 from rover_web.ros.admin import AdminNode, NoAnswer
 from rover_web.ros.fields import FieldError, build, describe
-from rover_web.ros.typesupport import UnknownMessageType, interface_class
+from rover_web.ros.typesupport import UnknownMessageType, interface_class, is_interface_package
 
 from .goals import Goal, GoalBook
 from .parameters import ParameterRefused, check_value
@@ -62,6 +63,14 @@ class RosAdmin:
 
     def recent(self, limit: int) -> list[dict]:
         return self.oplog.recent(LOG_NAME, limit)
+
+    def _check_estop(self, control: str, label: str, args: Any, client: str) -> None:
+        """After the request's own checks (a bad body is still 400): 409 estop_engaged, logged."""
+        try:
+            self.estop.check_motion()
+        except EStopEngaged:
+            self.record(control, label, args, "refused", "estop_engaged", client)
+            raise
 
     # --- nodes ---
 
@@ -115,7 +124,9 @@ class RosAdmin:
         try:
             cls = interface_class(type_name)
         except UnknownMessageType as exc:
-            raise AdminRefused(404 if "no " in str(exc) else 422, "unknown_type", str(exc)) from None
+            # An installed interface package without that type: 404; anything else: 422, as for calls.
+            missing = is_interface_package(package) if package.isidentifier() else False
+            raise AdminRefused(404 if missing else 422, "unknown_type", str(exc)) from None
         if kind == "msg":
             return {"type": type_name, "fields": describe(cls)}
         if kind == "srv":
@@ -128,16 +139,12 @@ class RosAdmin:
 
         args = {"type": type_name, "request": request}
         try:
-            self.estop.check_motion()
-        except Exception:
-            self.record("call_service", service, args, "refused", "estop_engaged", client)
-            raise
-        try:
             cls = _type_class(type_name, "srv")
             try:
                 message = build(cls.Request, request if request is not None else {}, "request")
             except FieldError as exc:
                 raise AdminRefused(400, exc.code, str(exc)) from None
+            self._check_estop("call_service", service, args, client)
             known = self.node.service_types(service)
             if known is None:
                 raise AdminRefused(404, "unknown_service", f"no service {service} in the ROS graph")
@@ -160,16 +167,12 @@ class RosAdmin:
     def send_goal(self, action: str, type_name: str, goal: Any, client: str) -> dict:
         args = {"type": type_name, "goal": goal}
         try:
-            self.estop.check_motion()
-        except Exception:
-            self.record("send_goal", action, args, "refused", "estop_engaged", client)
-            raise
-        try:
             cls = _type_class(type_name, "action")
             try:
                 message = build(cls.Goal, goal if goal is not None else {}, "goal")
             except FieldError as exc:
                 raise AdminRefused(400, exc.code, str(exc)) from None
+            self._check_estop("send_goal", action, args, client)
             tracked = Goal(None, action, type_name, None, client)
             try:
                 sent = self.node.send_goal(cls, action, message, GOAL_TIMEOUT_S, tracked.on_feedback,

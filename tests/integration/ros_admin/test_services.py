@@ -109,3 +109,13 @@ def test_type_descriptions_for_generated_forms(client):
     assert client.get("/api/types/json/srv/Thing").status_code == 422
     assert client.get("/api/types/std_srvs/srv/Nope").status_code == 404
     assert client.get("/api/types/std_srvs/foo/Trigger").status_code == 404
+
+
+def test_during_the_estop_a_bad_request_is_still_400(client):
+    client.post("/api/estop", json={"engaged": True})
+    assert call(client, "/x", SET_BOOL, {"data": 1}).status_code == 400
+    response = client.post("/api/actions/goal", json={"action": "/x", "type": "test_msgs/action/Fibonacci",
+                                                      "goal": {"order": "many"}})
+    assert (response.status_code, response.get_json()["error"]) == (400, "bad_type")
+    response = client.post("/api/actions/goal", json={"action": "/x", "type": "test_msgs/action/Fibonacci"})
+    assert (response.status_code, response.get_json()["error"]) == (409, "estop_engaged")
