@@ -4,6 +4,7 @@ import queue
 
 import pytest
 
+from rover_web.ros_admin.service import RosAdmin
 from tests.integration.ros_admin.conftest import wait_for_service
 
 pytestmark = pytest.mark.ros
@@ -119,3 +120,18 @@ def test_during_the_estop_a_bad_request_is_still_400(client):
     assert (response.status_code, response.get_json()["error"]) == (400, "bad_type")
     response = client.post("/api/actions/goal", json={"action": "/x", "type": "test_msgs/action/Fibonacci"})
     assert (response.status_code, response.get_json()["error"]) == (409, "estop_engaged")
+
+
+def test_the_main_node_gets_no_clients_from_these_calls(app, client, admin_peer):
+    """Service clients live on the admin node: the main executor's wait set (teleop, events) is untouched."""
+    node = app.extensions["rover_web"].runtime.node
+    def counts(n):
+        return len(list(n.clients)), len(list(n.waitables)), len(list(n.subscriptions))
+
+    before = counts(node)
+    wait_for_service(client, "/peer_ns/trigger")
+    assert call(client, "/peer_ns/trigger", "std_srvs/srv/Trigger").status_code == 200
+    assert client.get("/api/nodes/peer_ns/param_peer/parameters").status_code == 200
+    assert counts(node) == before
+    admin_node = app.extensions["rover_web"].feature(RosAdmin).node._node
+    assert counts(admin_node)[0] >= 4  # the Trigger client and the parameter clients are there instead
