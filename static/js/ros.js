@@ -218,7 +218,11 @@ function watchGoal(li, goal) {
   source.onerror = () => { source.close(); end(); };
 }
 
-for (const li of goalsList.querySelectorAll('li[data-goal]')) watchGoal(li, { goal_id: li.dataset.goal, status: li.dataset.status });
+// Finished goals are rendered by the server; only running ones are followed.
+const FINAL = new Set(['succeeded', 'canceled', 'aborted', 'unknown']);
+for (const li of goalsList.querySelectorAll('li[data-goal]')) {
+  if (!FINAL.has(li.dataset.status)) watchGoal(li, { goal_id: li.dataset.goal, status: li.dataset.status, action: li.dataset.action });
+}
 
 for (const box of document.querySelectorAll('.ros-action')) {
   const open = box.querySelector('.ros-goal-form');

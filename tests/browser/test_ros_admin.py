@@ -72,3 +72,22 @@ def test_set_a_parameter_call_a_service_and_send_a_goal(live_server, peers, page
     # The one console error is Chromium reporting the refused level's 400.
     assert [e for e in page.watch.console_errors if "status of 400" not in e] == []
     assert len(page.watch.console_errors) == 1 and not page.watch.offhost
+
+
+def test_a_running_goal_is_followed_after_a_reload_and_canceled_from_the_page(live_server, peers, page):
+    _admin, action = peers
+    url = live_server.url
+    wait_until(lambda: graph_ready(url), 20, "the peers in the app's graph")
+    sent = requests.post(url + "/api/actions/goal", json={"action": "/fibonacci", "type": "test_msgs/action/Fibonacci",
+                                                          "goal": {"order": 1000}}, timeout=15)
+    assert sent.status_code == 200
+    page.goto(url + "/ros")
+    goal = page.locator(f'#ros-goals li[data-goal="{sent.json()["goal_id"]}"]')
+    expect(goal).to_have_attribute("data-status", "executing", timeout=WAIT_MS)
+    goal.get_by_role("button", name="cancel").click()
+    action.wait("canceled")
+    expect(goal).to_have_attribute("data-status", "canceled", timeout=WAIT_MS)
+    page.reload()  # finished: rendered by the server, no stream opened
+    expect(page.locator(f'#ros-goals li[data-goal="{sent.json()["goal_id"]}"] .ros-goal-status')).to_have_text(
+        "canceled")
+    assert page.watch.console_errors == [] and not page.watch.offhost
