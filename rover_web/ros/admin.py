@@ -241,7 +241,19 @@ class AdminNode:
         def feedback(msg) -> None:
             on_feedback(message_to_dict(msg.feedback, 64))
 
-        handle = self._wait(client.send_goal_async(goal, feedback_callback=feedback), timeout_s, action)
+        sending = client.send_goal_async(goal, feedback_callback=feedback)
+        try:
+            handle = self._wait(sending, timeout_s, action)
+        except NoAnswer:
+            # The caller is told 504; a goal accepted after that would run with nobody watching it.
+            def cancel_late(future) -> None:
+                late = future.result() if not future.exception() else None
+                if late is not None and late.accepted:
+                    late.cancel_goal_async()
+
+            sending.add_done_callback(cancel_late)
+            self._executor.wake()
+            raise
         if not handle.accepted:
             return None
         goal_id = uuid.UUID(bytes=bytes(handle.goal_id.uuid)).hex
