@@ -68,6 +68,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         logs,
         panels,
         plot,
+        ros_admin,
         scan_the_code,
         telemetry,
         teleop,
@@ -122,6 +123,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         logs.init_app(app, rover)
         diagnostics.init_app(app, rover)
         plot.init_app(app, rover)  # after topics: plots share its subscriptions
+        ros_admin.init_app(app, rover)
     except BaseException:
         # A feature that failed to start may follow others that already started loops and
         # threads: stop them all in order, not just the node under them.

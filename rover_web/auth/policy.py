@@ -5,7 +5,7 @@ Roles, each including the ones below it:
             sees danger must be able to stop the robot.
   operator  also everything that moves or commands the robot: driving (the teleop WebSocket and
             REST), taking over, releasing the e-stop, LiveMap goals, waypoint writes, the mission
-            send, panel unlock and commands.
+            send, panel unlock and commands, other nodes' parameters, service calls, action goals.
   admin     also users and API tokens.
 The default is closed: a state-changing route nobody listed needs the operator role.
 """

@@ -52,3 +52,30 @@ def type_name(cls_or_msg) -> str:
     cls = cls_or_msg if isinstance(cls_or_msg, type) else type(cls_or_msg)
     package = cls.__module__.split(".")[0]
     return f"{package}/msg/{cls.__name__}"
+
+
+_INTERFACE_RE = re.compile(r"([a-z][a-z0-9_]*)/(msg|srv|action)/([A-Z][A-Za-z0-9]*)\Z")
+
+
+@lru_cache(maxsize=256)
+def interface_class(type_name: str) -> type:
+    """A message, service or action class by its full name ("std_srvs/srv/SetBool"), imported
+    only from a ROS interface package; UnknownMessageType with the reason otherwise."""
+    match = _INTERFACE_RE.match(type_name) if isinstance(type_name, str) else None
+    if not match:
+        raise UnknownMessageType(f"{str(type_name)[:80]!r} is not an interface type name like "
+                                 "std_srvs/srv/Trigger or test_msgs/action/Fibonacci")
+    package, kind, name = match.groups()
+    if kind == "msg":
+        return message_class(type_name)
+    if not is_interface_package(package):
+        raise UnknownMessageType(f"{package!r} is not installed as a ROS interface package")
+    try:
+        module = importlib.import_module(f"{package}.{kind}")
+    except ImportError:
+        raise UnknownMessageType(f"{package!r} has no {kind} types installed") from None
+    cls = getattr(module, name, None)
+    marker = "Request" if kind == "srv" else "Goal"
+    if cls is None or not hasattr(cls, marker):
+        raise UnknownMessageType(f"{package} has no {kind} {name!r}") from None
+    return cls

@@ -10,7 +10,7 @@ from tests.conftest import PageWatch
 
 pytestmark = pytest.mark.browser
 
-PAGES = ["/", "/livemap", "/topics", "/panels", "/waypoints", "/logs", "/diagnostics",
+PAGES = ["/", "/livemap", "/topics", "/panels", "/waypoints", "/logs", "/diagnostics", "/ros",
          "/plot?topic=/odom&field=twist.twist.linear.x"]
 
 

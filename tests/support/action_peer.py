@@ -41,3 +41,15 @@ class ActionServerPeer:
 
     def close(self) -> None:
         stop_piped(self.proc, "quit")
+
+
+class AdminPeer(ActionServerPeer):
+    """tests/support/peers/admin_peer.py: parameters of every type and std_srvs services."""
+
+    def __init__(self, namespace: str = "/peer_ns", name: str = "param_peer"):
+        self.proc = subprocess.Popen(
+            [sys.executable, str(ROOT / "tests" / "support" / "peers" / "admin_peer.py"), namespace, name],
+            stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=subprocess_env(), cwd=ROOT)
+        self.events = queue.Queue()
+        threading.Thread(target=self._read, daemon=True).start()
+        self.wait("ready", 20)

@@ -2,7 +2,9 @@
 
     python action_server.py /navigate_to_pose
 
-Goals run until canceled (one step every 50 ms). Lines on stdout, JSON: {"event": "ready"},
+Goals of order 1000 and more run until canceled (one step every 50 ms); a smaller order finishes
+after that many steps, with the Fibonacci sequence so far as feedback and the whole as result.
+Lines on stdout, JSON: {"event": "ready"},
 {"event": "accepted", "t": ...}, {"event": "canceled", "t": ...} (t: CLOCK_MONOTONIC seconds).
 On stdin, "goal" sends one goal to this very server (through an ActionClient), "quit" ends.
 """
@@ -31,6 +33,20 @@ def main() -> None:
 
     def execute(goal_handle):
         feedback = Fibonacci.Feedback()
+        order = goal_handle.request.order
+        if order < 1000:
+            sequence = [0, 1]
+            for _ in range(max(0, order - 1)):
+                if goal_handle.is_cancel_requested:
+                    goal_handle.canceled()
+                    emit(event="canceled", t=time.monotonic())
+                    return Fibonacci.Result(sequence=sequence)
+                sequence.append(sequence[-1] + sequence[-2])
+                feedback.sequence = sequence
+                goal_handle.publish_feedback(feedback)
+                time.sleep(0.05)
+            goal_handle.succeed()
+            return Fibonacci.Result(sequence=sequence)
         while rclpy.ok():
             if goal_handle.is_cancel_requested:
                 goal_handle.canceled()

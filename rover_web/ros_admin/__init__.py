@@ -1,0 +1,33 @@
+"""Nodes, parameters, services and actions from the browser: GET /ros and its API.
+
+  GET  /api/nodes                                   the graph's nodes, their topics, services, actions
+  GET  /api/nodes/<node>/parameters                 (node without its leading '/': ns/talker)
+  PUT  /api/nodes/<node>/parameters/<name>          {"value": v}
+  GET  /api/services                                POST /api/services/call
+  GET  /api/types/<pkg>/<msg|srv|action>/<Name>     a type's fields, for generated forms
+  POST /api/actions/goal   GET /api/actions/goals   GET /api/actions/<goal_id>/events (SSE)
+  POST /api/actions/<goal_id>/cancel                GET /api/ros/log (the operator log of all this)
+Calls go through rover_web.ros.admin on a node and executor of their own; goals sent from here are
+canceled when the e-stop engages. See docs/ros_admin.md.
+"""
+
+from __future__ import annotations
+
+from flask import Flask
+
+from rover_web.core.state import Rover
+from rover_web.estop import EStopService
+
+from . import routes
+from .service import RosAdmin
+
+__all__ = ["init_app", "RosAdmin"]
+
+
+def init_app(app: Flask, rover: Rover) -> None:
+    estop = rover.feature(EStopService)
+    admin = RosAdmin(rover, estop)
+    rover.add_feature(admin)
+    estop.on_engage(admin.on_estop)
+    app.register_blueprint(routes.bp)
+    rover.add_nav("ROS", "/ros")
