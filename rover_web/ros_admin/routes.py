@@ -129,7 +129,7 @@ def api_cancel_goal(goal_id: str):
 @bp.get("/api/ros/log")
 def api_log():
     limit = request.args.get("limit", "50")
-    if not limit.isdigit() or not 1 <= int(limit) <= 500:
+    if not (limit.isascii() and limit.isdigit()) or not 1 <= int(limit) <= 500:  # '²' is a digit to isdigit
         raise ApiError(400, "bad_limit", "limit is 1 to 500")
     return jsonify(entries=current_feature(RosAdmin).recent(int(limit)))
 
