@@ -32,7 +32,9 @@ def open_dashboard(page, server):
 
 
 def stick_center(page):
-    box = page.locator("#teleop-joystick").bounding_box()
+    stick = page.locator("#teleop-joystick")
+    stick.scroll_into_view_if_needed()  # the dashboard grew: the drive card may start below the fold
+    box = stick.bounding_box()
     return box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
 
 

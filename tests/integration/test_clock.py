@@ -76,6 +76,10 @@ WALL_CLOCK_ALLOWED = {
     "geofence/service.py": "`since` shown to people",
     "geofence/store.py": "when the fence was saved",
     "panels/oplog.py": "when a log line was written",
+    "plot/routes.py": "the plot's time axis is wall time, as its CSV export shows it",
+    "plot/service.py": "when a sample arrived, for the plot's time axis",
+    "ros_admin/goals.py": "when a goal was sent, shown to people",
+    "web/status.py": "/api/ping's answer: the server's clock, shown beside the round trip",
     "waypoints/store.py": "created_at of a waypoint",
 }
 

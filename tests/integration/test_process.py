@@ -111,7 +111,8 @@ def test_a_served_app_keeps_its_start_up_heap_out_of_the_collector(tmp_path):
     script = (
         "import gc, json\n"
         "from rover_web import create_app\n"
-        "create_app({'TESTING': True})\n"
+        "import os\n"
+        "create_app({'TESTING': True, 'ROVER_WEB_DB_PATH': os.environ['ROVER_WEB_DB_PATH'] + '.test'})\n"
         "testing = gc.get_freeze_count()\n"
         "create_app()\n"
         "served = gc.get_freeze_count()\n"

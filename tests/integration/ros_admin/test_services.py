@@ -6,6 +6,7 @@ import pytest
 
 from rover_web.ros_admin.service import RosAdmin
 from tests.integration.ros_admin.conftest import wait_for_service
+from tests.support.waiting import wait_until
 
 pytestmark = pytest.mark.ros
 
@@ -131,7 +132,9 @@ def test_the_main_node_gets_no_clients_from_these_calls(app, client, admin_peer)
     before = counts(node)
     wait_for_service(client, "/peer_ns/trigger")
     assert call(client, "/peer_ns/trigger", "std_srvs/srv/Trigger").status_code == 200
-    assert client.get("/api/nodes/peer_ns/param_peer/parameters").status_code == 200
+    # The node's name can be discovered a moment after its services: wait for it as for them.
+    wait_until(lambda: client.get("/api/nodes/peer_ns/param_peer/parameters").status_code == 200, 15,
+               "the peer's parameters listed")
     assert counts(node) == before
     admin_node = app.extensions["rover_web"].feature(RosAdmin).node._node
     assert counts(admin_node)[0] >= 4  # the Trigger client and the parameter clients are there instead
