@@ -134,6 +134,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
             db_claim.release()
         raise
     app.register_blueprint(pages.bp)
+    rover.add_nav("Status", "/status")
     app.register_blueprint(status.bp)
     app.register_blueprint(sse.bp)
     apidocs.init_app(app, rover)  # after every route: it describes them all (docs/api.md)

@@ -4,6 +4,7 @@ from rover_web.apidocs.describe import header, obj, op, page, query
 
 PATHS = {
     "/": {"get": page("The dashboard", tag="pages")},
+    "/status": {"get": page("The node, its topics and the link plot", tag="pages")},
     "/api/ping": {"get": op("The server's clock, for timing a round trip", tag="status",
                             ok=obj({"t": {"type": "number"}}))},
     "/api/status": {"get": op("The node, its topics and the process, as the status channel", tag="status",

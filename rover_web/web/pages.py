@@ -21,6 +21,12 @@ def dashboard():
                            panels=rover.dashboard_panels, channels=channels)
 
 
+@bp.get("/status")
+def status_page():
+    """The node, its topics and the link plot (round trip, newest robot message), on a page of their own."""
+    return render_template("status.html", status=build_status(current_rover()))
+
+
 @bp.app_context_processor
 def layout_context():
     rover = current_rover()

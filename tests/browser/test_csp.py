@@ -10,7 +10,7 @@ from tests.conftest import PageWatch
 
 pytestmark = pytest.mark.browser
 
-PAGES = ["/", "/livemap", "/topics", "/panels", "/waypoints", "/logs", "/diagnostics", "/ros",
+PAGES = ["/", "/status", "/livemap", "/topics", "/panels", "/waypoints", "/logs", "/diagnostics", "/ros",
          "/plot?topic=/odom&field=twist.twist.linear.x"]
 
 
@@ -27,6 +27,8 @@ def test_no_page_breaks_the_content_security_policy(live_server, browser, sim_pr
                 page.wait_for_selector(".maplibregl-canvas", timeout=10000)  # its worker comes from blob:
                 page.wait_for_selector("#teleop-link[data-state='live']", timeout=10000)
                 page.wait_for_selector("#link-plot canvas", timeout=10000)  # uPlot draws under the policy
+            if path == "/status":
+                page.wait_for_selector("#link-plot canvas", timeout=10000)
             if path.startswith("/plot"):
                 page.wait_for_selector("#plot-chart canvas", timeout=10000)
         refused = [m for m in watch.console_errors if "Content Security Policy" in m or "Refused to" in m]

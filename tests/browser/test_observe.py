@@ -110,3 +110,15 @@ def test_the_dashboard_shows_diagnostics_and_the_link_plot(live_server, sim_proc
     page.wait_for_function("document.querySelector('#diag-body').textContent.includes('sim_rover: gps')",
                            timeout=10000)
     assert page.watch.console_errors == [] and page.watch.offhost == []
+
+
+def test_the_status_page_plots_the_round_trip_and_the_robots_newest_message(live_server, sim_process, page):
+    sim_process("--only", "rover")
+    page.goto(live_server.url + "/status")
+    page.wait_for_function("Number(document.querySelector('#link-plot').dataset.points) >= 3", timeout=15000)
+    assert float(page.get_attribute("#link-plot", "data-rtt-ms")) > 0
+    page.wait_for_function("document.querySelector('#link-plot').dataset.ageMs !== ''", timeout=10000)
+    assert page.locator("#link-plot canvas").count() == 1
+    page.wait_for_function("document.querySelector('#status-topics').textContent.includes('/odom')", timeout=10000)
+    assert page.locator("nav a[aria-current='page']").inner_text() == "Status"
+    assert page.watch.console_errors == [] and page.watch.offhost == []
