@@ -13,6 +13,34 @@ function $(id) { return document.getElementById(id); }
 
 const closeRing = (points) => [...points, points[0]];
 
+// Even-odd ray casting in lng/lat: fine at the scale of a fence, and it answers from the draft
+// itself, so a click selects the area even while MapLibre is still re-tiling the source after
+// a save (queryRenderedFeatures then saw nothing and the click silently selected nothing).
+function inRing(ring, [x, y]) {
+  let inside = false;
+  for (let i = 0, j = ring.length - 1; i < ring.length; j = i++) {
+    const [xi, yi] = ring[i];
+    const [xj, yj] = ring[j];
+    if ((yi > y) !== (yj > y) && x < ((xj - xi) * (y - yi)) / (yj - yi) + xi) inside = !inside;
+  }
+  return inside;
+}
+
+function contains(geometry, point) {
+  const polygons = geometry.type === 'Polygon' ? [geometry.coordinates] : geometry.coordinates;
+  return polygons.some(([outer, ...holes]) => inRing(outer, point) && !holes.some((h) => inRing(h, point)));
+}
+
+// Keep-out areas are drawn on top, so they are picked first; among equals, the latest drawn.
+function areaAt(features, point) {
+  for (const kind of ['keep_out', 'keep_in']) {
+    for (let i = features.length - 1; i >= 0; i -= 1) {
+      if (features[i].properties.kind === kind && contains(features[i].geometry, point)) return i;
+    }
+  }
+  return -1;
+}
+
 export function attachGeofence(map) {
   const box = $('gf-editor');
   if (!box) return { handleClick: () => false };
@@ -40,7 +68,7 @@ export function attachGeofence(map) {
 
   function collection() {
     return { type: 'FeatureCollection',
-      features: draft.map((f, i) => ({ ...f, properties: { ...f.properties, index: i, selected: i === selected } })) };
+      features: draft.map((f, i) => ({ ...f, properties: { ...f.properties, selected: i === selected } })) };
   }
 
   function draftShape() {
@@ -126,8 +154,7 @@ export function attachGeofence(map) {
       drawing.points.push([lng, lat]);
       say(`${drawing.points.length} vertices: click on, then "Finish area"`);
     } else {
-      const hit = map.queryRenderedFeatures(e.point, { layers: ['fence-keep-out-fill', 'fence-keep-in-fill'] });
-      selected = hit.length ? hit[0].properties.index : -1;
+      selected = areaAt(draft, [lng, lat]);
       say(selected >= 0 ? 'Area selected: drag its vertices, or delete it' : '');
     }
     redraw();
