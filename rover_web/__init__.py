@@ -75,13 +75,14 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         topics,
         waypoints,
     )
-    from rover_web.core.state import EXTENSION, Rover
-    from rover_web.events.broadcast import Broadcaster
-    from rover_web.events.hub import EventHub
-    from rover_web.ros.cmd_vel import CmdVelOutput
+    from rover_web import (
+        fleet as fleet_pages,
+    )
+    from rover_web.core.state import EXTENSION
+    from rover_web.fleet import build_fleet
     from rover_web.ros.runtime import RosRuntime
     from rover_web.storage.claim import claim
-    from rover_web.storage.db import Database, database_path
+    from rover_web.storage.db import database_path
     from rover_web.web import pages, sse, status
 
     db_path = database_path(app)
@@ -91,56 +92,48 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     except BaseException:
         db_claim.release()
         raise
-    rover = None
+    fleet = None
     try:
-        cmd_vel = CmdVelOutput(runtime, settings["ROVER_WEB_CMD_VEL_TOPIC"],
-                               max_linear_mps=settings["ROVER_WEB_MAX_LINEAR_MPS"],
-                               max_angular_rps=settings["ROVER_WEB_MAX_ANGULAR_RPS"],
-                               stamped=settings["ROVER_WEB_CMD_VEL_STAMPED"],
-                               frame_id=settings["ROVER_WEB_CMD_VEL_FRAME_ID"])
-        hub = EventHub(max_clients=settings["ROVER_WEB_SSE_MAX_CLIENTS"])
-        db = Database(db_path)
-        db.check()
-        rover = Rover(settings, hub, runtime, cmd_vel, db=db,
-                      broadcaster=Broadcaster(hub, settings["ROVER_WEB_SSE_KEEPALIVE_S"]))
-        rover.on_shutdown(db_claim.release)  # shutdown hooks run last first: after the database closes
-        rover.on_shutdown(rover.db.close)
-        app.extensions[EXTENSION] = rover
-        auth.init_app(app, rover)  # first: every route after it is checked for sign-in and role
-        estop.init_app(app, rover)  # before every feature that moves the robot: they gate on it
-        geofence.init_app(app, rover)  # before waypoints and livemap: they check it before publishing
-        # Features, in dashboard order of their cards; each registers its routes, channels,
-        # subscriptions and panels.
-        telemetry.init_app(app, rover)
-        teleop.init_app(app, rover)
-        basemap.init_app(app, rover)
-        waypoints.init_app(app, rover)
-        scan_the_code.init_app(app, rover)
-        panels.init_app(app, rover)
-        livemap.init_app(app, rover)
-        camera.init_app(app, rover)
-        topics.init_app(app, rover)
-        logs.init_app(app, rover)
-        diagnostics.init_app(app, rover)
-        plot.init_app(app, rover)  # after topics: plots share its subscriptions
-        ros_admin.init_app(app, rover)
+        fleet = build_fleet(settings, runtime, db_path, db_claim)  # one Rover per robot (core/fleet.py)
+        graph = fleet.graph  # the graph-wide scope: the first robot when there is only one
+        app.extensions[EXTENSION] = fleet.first
+        auth.init_app(app, graph)  # first: every route after it is checked for sign-in and role
+        estop.init_app(app, fleet)  # before every feature that moves the robot: they gate on it
+        geofence.init_app(app, fleet)  # before waypoints and livemap: they check it before publishing
+        # Features, in dashboard order of their cards; each registers its routes once and sets up
+        # every robot (a fleet) or the graph-wide scope (graph) it serves.
+        telemetry.init_app(app, fleet)
+        teleop.init_app(app, fleet)
+        basemap.init_app(app, graph)
+        waypoints.init_app(app, fleet)
+        scan_the_code.init_app(app, fleet)
+        panels.init_app(app, fleet)
+        livemap.init_app(app, fleet)
+        camera.init_app(app, fleet)
+        topics.init_app(app, graph)
+        logs.init_app(app, graph)
+        diagnostics.init_app(app, fleet)
+        plot.init_app(app, graph)  # after topics: plots share its subscriptions
+        ros_admin.init_app(app, graph)
+        fleet_pages.init_app(app, fleet)  # /robots, /api/robots and /robots/<name>/... for every route
     except BaseException:
         # A feature that failed to start may follow others that already started loops and
         # threads: stop them all in order, not just the node under them.
-        if rover is not None:
-            rover.shutdown()
+        if fleet is not None:
+            fleet.shutdown()
         else:
             runtime.stop(0.5)
             db_claim.release()
         raise
     app.register_blueprint(pages.bp)
-    rover.add_nav("Status", "/status")
+    graph.add_nav("Status", "/status")
     app.register_blueprint(status.bp)
     app.register_blueprint(sse.bp)
-    apidocs.init_app(app, rover)  # after every route: it describes them all (docs/api.md)
+    apidocs.init_app(app, graph)  # after every route: it describes them all (docs/api.md)
     runtime.start()
-    status.start_reporter(rover)
+    for rover in fleet:
+        status.start_reporter(rover)
     if not app.testing:
-        process.stop_with_process(rover)
+        process.stop_with_process(fleet.first)
         process.freeze_startup_heap()
     return app

@@ -46,6 +46,9 @@ TOPIC_PATTERN = re.compile(r"/?[A-Za-z_~{][A-Za-z0-9_{}~]*(/[A-Za-z_{][A-Za-z0-9
 SETTINGS: tuple[Setting, ...] = (
     # --- process and ROS node ---
     Setting("NODE_NAME", "rover_web", "str", "name of the app's ROS 2 node"),
+    Setting("ROBOTS", [], "robots",
+            "the robots served: JSON [{\"name\": \"boat\", \"namespace\": \"/boat\", \"kind\": \"boat\"}, ...] "
+            "or the short form boat,rover,drone; empty: one robot, no namespace (docs/fleet.md)"),
     Setting("ROS_DOMAIN_ID", None, "optional_int",
             "ROS domain id for the app's node; unset uses ROS_DOMAIN_ID from the environment (or 0)", 0, 232),
     Setting("HOST", None, "optional_str",
@@ -79,6 +82,8 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("LINK_TOPICS", ["/odom"], "list",
             "topics whose freshness defines the server-robot link in the health bar"),
     Setting("ODOM_TOPIC", "/odom", "topic", "nav_msgs/Odometry the dashboard shows speed from"),
+    Setting("BATTERY_TOPIC", "/battery_state", "topic",
+            "sensor_msgs/BatteryState shown as the battery level on the dashboard and /robots, when published"),
     Setting("ODOM_MAX_HZ", 10.0, "float", "most `odom` channel updates a second sent to browsers", 0.1, 1000),
     # --- e-stop ---
     Setting("ESTOP_TOPIC", "/e_stop", "topic",
@@ -258,7 +263,13 @@ def _from_text(setting: Setting, text: str) -> Any:
             return float(stripped)
         except ValueError:
             return text
-    if kind == "list":
+    if kind == "robots":
+        from rover_web.core.robots import from_text
+
+        stripped = from_text(stripped)
+        if not isinstance(stripped, str):
+            return stripped
+    if kind in ("list", "robots"):
         if stripped.startswith("["):
             try:
                 return json.loads(stripped)
@@ -293,6 +304,14 @@ def _check(setting: Setting, value: Any, source: str) -> Any:
         if setting.low is not None and value < setting.low or setting.high is not None and value > setting.high:
             raise fail(f"a value from {setting.low:g} to {setting.high:g}")
         return int(value) if kind == "int" else float(value)
+    if kind == "robots":
+        from rover_web.core.robots import RobotsError, parse
+
+        try:
+            robots = parse(value)
+        except RobotsError as exc:
+            raise ConfigError(f"{name}: {exc} (from {source})") from None
+        return [r.as_dict() for r in robots] if value else []
     if kind == "list":
         if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
             raise fail("a list of strings")

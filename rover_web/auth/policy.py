@@ -22,7 +22,8 @@ READ_METHODS = frozenset({"GET", "HEAD", "OPTIONS"})
 # Reachable without signing in: the sign-in form itself and the files it needs.
 PUBLIC_ENDPOINTS = frozenset({"auth.login_form", "auth.login", "static"})
 # Any signed-in user, whatever the method.
-ANY_USER_ENDPOINTS = frozenset({"auth.logout", "estop.estop_set"})  # estop_set: the view checks release
+# estop_set: the view checks release; estop_all only engages: whoever may watch may stop every robot.
+ANY_USER_ENDPOINTS = frozenset({"auth.logout", "estop.estop_set", "estop.estop_all"})
 ADMIN_ENDPOINT_PREFIX = "auth.admin_"
 
 

@@ -9,17 +9,23 @@ tells who watches what.
 
 from __future__ import annotations
 
-from rover_web.core.state import Rover
+from rover_web.core.fleet import Fleet
+from rover_web.core.state import Rover, current_feature
 
 from . import routes
 from .service import CameraStreams
 
 
-def init_app(app, rover: Rover) -> None:
+def init_app(app, fleet: Fleet) -> None:
+    for rover in fleet:
+        _init_robot(rover)
+    app.register_blueprint(routes.bp)
+    app.jinja_env.globals["camera_panel"] = lambda: current_feature(CameraStreams).panel()
+
+
+def _init_robot(rover: Rover) -> None:
     streams = CameraStreams(rover)
     rover.add_feature(streams)
     streams.producers.start_reaper("camera-reaper")
     rover.on_shutdown(streams.close)
-    app.register_blueprint(routes.bp)
-    app.jinja_env.globals["camera_panel"] = streams.panel
     rover.add_panel(20, "panels/camera.html", "Camera")

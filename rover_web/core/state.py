@@ -13,12 +13,14 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from flask import current_app
+from flask import current_app, has_request_context, request
 
 from rover_web.core.loops import Loop, every
+from rover_web.core.robots import Robot
 from rover_web.core.streams import StreamLimit
 
 if TYPE_CHECKING:
+    from rover_web.core.fleet import Fleet
     from rover_web.events.broadcast import Broadcaster
     from rover_web.events.hub import EventHub
     from rover_web.ros.cmd_vel import CmdVelOutput
@@ -28,6 +30,7 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 EXTENSION = "rover_web"
+ROBOT_ENVIRON = "rover_web.robot"  # set by rover_web/fleet/prefix.py
 LOOP_JOIN_S = 2.0
 
 T = TypeVar("T")
@@ -48,17 +51,24 @@ class DashboardPanel:
 
 
 class Rover:
-    def __init__(self, config: dict[str, Any], hub: EventHub, runtime: RosRuntime, cmd_vel: CmdVelOutput,
-                 db: Database, broadcaster: Broadcaster):
+    """One robot (or, as a Fleet's `graph`, the graph-wide scope): its settings, hub and features."""
+
+    def __init__(self, config: dict[str, Any], hub: EventHub, runtime: RosRuntime, cmd_vel: CmdVelOutput | None,
+                 db: Database, broadcaster: Broadcaster, *, robot: Robot | None = None,
+                 streams: StreamLimit | None = None, nav_links: list[tuple[str, str]] | None = None):
         self.config = config
         self.hub = hub
         self.runtime = runtime
         self.cmd_vel = cmd_vel
         self.db = db
         self.broadcaster = broadcaster  # writes every SSE stream
-        self.streams = StreamLimit(config["ROVER_WEB_MAX_STREAMS"])  # SSE, MJPEG, echo and teleop sockets
+        self.robot = robot or Robot("robot")
+        self.fleet: Fleet | None = None  # set by the Fleet that holds this robot
+        # SSE, MJPEG, echo and teleop sockets: one limit for the process, shared by every robot.
+        self.streams = streams or StreamLimit(config["ROVER_WEB_MAX_STREAMS"])
         self.dashboard_panels: list[DashboardPanel] = []
-        self.nav_links: list[tuple[str, str]] = [("Dashboard", "/")]
+        # Every robot has the same features, so one list of links serves them all.
+        self.nav_links: list[tuple[str, str]] = [("Dashboard", "/")] if nav_links is None else nav_links
         self._features: dict[type, object] = {}
         self._loops: list[Loop] = []
         self.link_lost_hooks: list[Callable[[], None]] = []
@@ -79,12 +89,14 @@ class Rover:
         self._features[type(service)] = service
 
     def feature(self, cls: type[T]) -> T:
-        try:
-            return self._features[cls]  # type: ignore[return-value]
-        except KeyError:
+        found = self._features.get(cls)
+        if found is None and self.fleet is not None and self.fleet.graph is not self:
+            found = self.fleet.graph._features.get(cls)  # a graph-wide feature, shared by every robot
+        if found is None:
             package = cls.__module__.rsplit(".", 1)[0]
             raise NotSetUp(f"{cls.__name__} is not set up on this app: did you forget "
-                           f"{package}.init_app(app, rover) in create_app?") from None
+                           f"{package}.init_app(app, rover) in create_app?")
+        return found  # type: ignore[return-value]
 
     def add_panel(self, order: int, template: str, title: str = "", channels: tuple[str, ...] = ()) -> None:
         """Show `template` on the dashboard; `channels` are the SSE channels its script listens to."""
@@ -92,7 +104,12 @@ class Rover:
         self.dashboard_panels.sort()
 
     def add_nav(self, label: str, href: str) -> None:
-        self.nav_links.append((label, href))
+        if (label, href) not in self.nav_links:  # each robot's features add the same links
+            self.nav_links.append((label, href))
+
+    def resolve(self, name: str) -> str:
+        """A ROS name from a feature's own files (a panel's topic) under this robot's namespace."""
+        return self.robot.resolve(name)
 
     # --- background work and shutdown ---
 
@@ -113,14 +130,30 @@ class Rover:
         self._shutdown_hooks.append(hook)
 
     def shutdown(self) -> None:
-        """Ordered stop: robot to zero, event streams ended, loops joined, features, then ROS."""
+        """Ordered stop: robot to zero, event streams ended, loops joined, features, then ROS.
+
+        Any robot's shutdown is the whole process's: every robot of its fleet stops with it."""
+        if self.fleet is not None:
+            self.fleet.shutdown()
+            return
         if self._stopping.is_set():
             return
+        self.halt()
+        self.wind_down()
+        self.runtime.stop(self.config["ROVER_WEB_SHUTDOWN_TIMEOUT_S"])
+
+    def halt(self) -> None:
+        """The first step of shutdown: stop the loops' work and publish a zero velocity."""
         self._stopping.set()
+        if self.cmd_vel is None:
+            return
         try:
             self.cmd_vel.halt()
         except Exception:
             log.exception("could not publish the final zero velocity")
+
+    def wind_down(self) -> None:
+        """After every robot halted: end event streams, join loops, run the features' hooks."""
         self.hub.close()
         for loop in self._loops:
             if not loop.join(LOOP_JOIN_S):
@@ -130,7 +163,6 @@ class Rover:
                 hook()
             except Exception:
                 log.exception("shutdown hook %r failed", hook)
-        self.runtime.stop(self.config["ROVER_WEB_SHUTDOWN_TIMEOUT_S"])
 
 
 def rover_of(app) -> Rover:
@@ -142,7 +174,12 @@ def rover_of(app) -> Rover:
 
 
 def current_rover() -> Rover:
-    return rover_of(current_app)
+    """The robot the request is for: /robots/<name>/... names it, any other path is the first's."""
+    rover = rover_of(current_app)
+    if rover.fleet is None or not has_request_context():
+        return rover
+    name = request.environ.get(ROBOT_ENVIRON)
+    return rover.fleet.get(name) or rover if name else rover
 
 
 def current_feature(cls: type[T]) -> T:

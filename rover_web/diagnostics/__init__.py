@@ -8,18 +8,24 @@ Modules: board (latest per name, staleness, worst per hardware id), msgs.
 
 from __future__ import annotations
 
+from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
 
 from . import routes
 from .service import REFRESH_S, Diagnostics
 
 
-def init_app(app, rover: Rover) -> None:
+def init_app(app, fleet: Fleet) -> None:
+    for rover in fleet:
+        _init_robot(rover)
+    app.register_blueprint(routes.bp)
+
+
+def _init_robot(rover: Rover) -> None:
     diagnostics = Diagnostics(rover)
     rover.add_feature(diagnostics)
     rover.hub.register("diagnostics")
     diagnostics.subscribe()
-    app.register_blueprint(routes.bp)
     rover.add_nav("Diagnostics", "/diagnostics")
     rover.add_panel(80, "panels/diagnostics.html", "Diagnostics", channels=("diagnostics",))
     rover.every(REFRESH_S, diagnostics.refresh, name="diagnostics-refresh")

@@ -18,7 +18,7 @@ class Diagnostics:
 
     def subscribe(self) -> None:
         # /diagnostics_agg is subscribed even when no aggregator runs: an unmatched subscription costs nothing.
-        for topic in msgs.TOPICS:
+        for topic in map(self.rover.resolve, msgs.TOPICS):  # each robot's own /diagnostics
             self.rover.runtime.subscribe(msgs.DIAGNOSTIC_ARRAY, topic,
                                          lambda msg, topic=topic: self.on_array(msg, topic), qos=50, track=False)
 

@@ -18,4 +18,17 @@ PATHS = {
             description="`{\"engaged\": true}` always engages, whatever else the body holds.",
             fuzz="last", fuzz_why="engaged, it turns every motion route into a 409 for the rest of the run"),
     },
+    "/api/estop/all": {
+        "post": op(
+            "Engage every robot's e-stop (the \"Stop all\" button)", tag="estop",
+            ok=obj({"engaged": {"type": "boolean"},
+                    "robots": {"type": "object", "additionalProperties": STATE,
+                               "description": "each robot's latch, by robot name"}}),
+            body=obj({"by": {"type": ["string", "null"], "maxLength": 40, "description": "who, when sign-in is off"}}),
+            body_required=False,
+            errors={400: "bad_json, non_finite, unknown_field, bad_type, too_long"},
+            description="Any signed-in user may stop every robot; each is released on its own "
+                        "(`POST /robots/<name>/api/estop`).",
+            fuzz="last", fuzz_why="engaged, it turns every motion route into a 409 for the rest of the run"),
+    },
 }

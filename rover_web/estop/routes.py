@@ -1,4 +1,4 @@
-"""GET /api/estop (the latch) and POST /api/estop ({"engaged": true|false})."""
+"""GET /api/estop (the latch), POST /api/estop ({"engaged": true|false}), POST /api/estop/all."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ from rover_web.core.state import current_feature
 from rover_web.web.http import ApiError, error_response, json_body
 from rover_web.web.validate import InvalidInput, only_keys, text
 
+from .fleet import FleetEStop
 from .service import EStopEngaged, EStopService, ReleaseRefused
 
 bp = Blueprint("estop", __name__)
@@ -39,6 +40,19 @@ def estop_engaged(exc: EStopEngaged):
 def estop_state():
     estop = current_feature(EStopService)
     return jsonify({**estop.state(), "cancellable_actions": estop.cancellable_actions()})
+
+
+@bp.post("/api/estop/all")
+def estop_all():
+    """Engage every robot's e-stop (the "Stop all" button); releasing stays one robot at a time."""
+    body = json_body(required=False)
+    try:
+        only_keys(body, {"by"})
+        by = text(body, "by", max_len=NAME_MAX_LEN, default=None)
+    except InvalidInput as exc:
+        raise ApiError(400, exc.code, str(exc)) from None
+    robots = current_feature(FleetEStop).engage_all(client_name(by))
+    return jsonify({"engaged": all(state["engaged"] for state in robots.values()), "robots": robots})
 
 
 @bp.post("/api/estop")

@@ -16,7 +16,8 @@ from __future__ import annotations
 import json
 
 from rover_web.config import ROOT, ConfigError
-from rover_web.core.state import Rover
+from rover_web.core.fleet import Fleet
+from rover_web.core.state import Rover, current_feature
 from rover_web.estop import EStopService
 
 from . import routes
@@ -30,7 +31,14 @@ __all__ = ["init_app", "GeofenceService", "OutsideGeofence", "outside_geofence_r
 CHECK_PERIOD_S = 0.1
 
 
-def init_app(app, rover: Rover) -> None:
+def init_app(app, fleet: Fleet) -> None:
+    for rover in fleet:
+        _init_robot(rover)
+    app.register_blueprint(routes.bp)
+    app.context_processor(lambda: {"geofence_state": current_feature(GeofenceService).state()})
+
+
+def _init_robot(rover: Rover) -> None:
     config = rover.config
     service = GeofenceService(GeofenceStore(rover.db), rover.feature(EStopService), rover.hub,
                               max_vertices=config["ROVER_WEB_GEOFENCE_MAX_VERTICES"],
@@ -39,10 +47,8 @@ def init_app(app, rover: Rover) -> None:
     if config["ROVER_WEB_GEOFENCE_FILE"]:
         service.seed(_read_file(config["ROVER_WEB_GEOFENCE_FILE"], service.max_vertices))
     rover.add_feature(service)
-    app.register_blueprint(routes.bp)
     rover.hub.publish(CHANNEL, service.state())
     rover.every(CHECK_PERIOD_S, service.evaluate, name="geofence-check", only_while=service.pending)
-    app.context_processor(lambda: {"geofence_state": service.state()})
 
 
 def _read_file(name: str, max_vertices: int) -> dict:

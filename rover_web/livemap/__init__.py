@@ -10,6 +10,7 @@ geometry, occupancy, msgs.
 
 from __future__ import annotations
 
+from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
 
@@ -17,7 +18,13 @@ from . import msgs, routes
 from .service import STALE_CHECK_S, LiveMapService, load_files
 
 
-def init_app(app, rover: Rover) -> None:
+def init_app(app, fleet: Fleet) -> None:
+    for rover in fleet:
+        _init_robot(rover)
+    app.register_blueprint(routes.bp)  # with the dashboard card's context (livemap_panel)
+
+
+def _init_robot(rover: Rover) -> None:
     config = rover.config
     files = load_files(config)
     runtime = rover.runtime
@@ -35,7 +42,6 @@ def init_app(app, rover: Rover) -> None:
         runtime.subscribe(msgs.OCCUPANCY_GRID, service.map_topic, lambda m: service.on_grid(*msgs.occupancy_grid(m)),
                           "latched")
 
-    app.register_blueprint(routes.bp)  # with the dashboard card's context (livemap_panel)
     rover.add_panel(30, "panels/livemap.html", "Live map", channels=("pose",))
     rover.add_nav("Live map", "/livemap")
     rover.every(STALE_CHECK_S, service.check_staleness, name="livemap-staleness")

@@ -43,6 +43,7 @@ def map_summary(definition: MapDefinition) -> dict:
     g = definition.geometry
     quoted = quote(definition.name, safe="")
     version = f"?v={definition.version}" if definition.source == "live" else ""
+    root = request.script_root
     return {
         "name": definition.name, "label": definition.label, "source": definition.source,
         "version": definition.version,
@@ -50,9 +51,10 @@ def map_summary(definition: MapDefinition) -> dict:
         "cm_per_pixel": g.cm_per_pixel, "width_m": round(g.width_m, 6), "height_m": round(g.height_m, 6),
         "origin": [g.origin_x, g.origin_y, g.origin_yaw], "waypoint_count": len(definition.waypoints),
         "keep_out": [a.as_dict() for a in definition.keep_out],
-        "urls": {"state": f"/api/maps/{quoted}", "image": f"/api/maps/{quoted}/image{version}",
-                 "thumbnail": f"/api/maps/{quoted}/thumbnail{version}", "page": f"/livemap/{quoted}",
-                 "goal": f"/api/maps/{quoted}/goal"},
+        # Under the robot's prefix (/robots/<name>): a live map is that robot's own.
+        "urls": {"state": f"{root}/api/maps/{quoted}", "image": f"{root}/api/maps/{quoted}/image{version}",
+                 "thumbnail": f"{root}/api/maps/{quoted}/thumbnail{version}", "page": f"{root}/livemap/{quoted}",
+                 "goal": f"{root}/api/maps/{quoted}/goal"},
     }
 
 

@@ -9,6 +9,7 @@ side and the command path), oplog (SQLite operator log), msgs (message fields), 
 
 from __future__ import annotations
 
+from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
 
@@ -18,16 +19,22 @@ from .oplog import OperatorLog
 from .service import TICK_S, PanelService
 
 
-def init_app(app, rover: Rover) -> None:
+def init_app(app, fleet: Fleet) -> None:
+    for rover in fleet:
+        _init_robot(rover)
+    app.register_blueprint(routes.bp)
+
+
+def _init_robot(rover: Rover) -> None:
     config = rover.config
     specs = spec.load(config["ROVER_WEB_PANELS_FILE"], config["ROVER_WEB_STALE_AFTER_S"], field_kind)
+    specs = tuple(s.resolved(rover.resolve) for s in specs)  # each robot's panels drive its own topics
     rover.hub.register("panel", "panel_log")
     estop = rover.feature(EStopService)
     service = PanelService(specs, rover, OperatorLog(rover.db, config["ROVER_WEB_PANELS_LOG_KEEP"]), estop)
     rover.add_feature(service)
     estop.on_engage(service.on_estop)
     estop.on_release(lambda _by: service.publish_view())  # the page's buttons come back
-    app.register_blueprint(routes.bp)
     rover.add_panel(20, "panels/panels.html", "Control panels", channels=("panel",))
     rover.add_nav("Panels", "/panels")
     service.publish_view()

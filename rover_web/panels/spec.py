@@ -16,7 +16,7 @@ import math
 import re
 import tomllib
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -190,6 +190,11 @@ class PanelSpec:
 
     def control(self, control_id: str) -> ControlSpec | None:
         return next((c for c in self.controls if c.id == control_id), None)
+
+    def resolved(self, resolve: Callable[[str], str]) -> PanelSpec:
+        """This panel with its topics under a robot's namespace (rover.resolve)."""
+        return replace(self, displays=tuple(replace(d, topic=resolve(d.topic)) for d in self.displays),
+                       controls=tuple(replace(c, topic=resolve(c.topic)) for c in self.controls))
 
 
 FieldKind = Callable[[str, str], str]  # (message type, field path) -> kind; ValueError if no such field

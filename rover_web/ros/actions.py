@@ -24,10 +24,11 @@ RETURN_CODES = {0: "canceled", 1: "rejected", 2: "no_goals", 3: "no_goals"}  # 2
 
 
 class GoalCanceller:
-    def __init__(self, runtime, actions: list[str]):
+    def __init__(self, runtime, actions: list[str], namespace: str = ""):
         context = runtime.context
+        # In the robot's namespace: each robot's canceller is a node of its own name (/boat/rover_web_estop).
         self._node = rclpy.create_node(
-            f"{runtime.node.get_name()}_estop", namespace=runtime.node.get_namespace(), context=context,
+            f"{runtime.node.get_name()}_estop", namespace=namespace or runtime.node.get_namespace(), context=context,
             start_parameter_services=False,
             parameter_overrides=[Parameter("start_type_description_service", value=False)])
         self._clients = {name: self._node.create_client(CancelGoal, f"{name.rstrip('/')}/_action/cancel_goal")

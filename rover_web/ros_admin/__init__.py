@@ -16,7 +16,7 @@ from __future__ import annotations
 from flask import Flask
 
 from rover_web.core.state import Rover
-from rover_web.estop import EStopService
+from rover_web.estop import FleetEStop
 
 from . import routes
 from .service import RosAdmin
@@ -25,7 +25,8 @@ __all__ = ["init_app", "RosAdmin"]
 
 
 def init_app(app: Flask, rover: Rover) -> None:
-    estop = rover.feature(EStopService)
+    # Graph-wide: a call or goal names no robot, so any robot's e-stop refuses it and cancels it.
+    estop = rover.feature(FleetEStop)
     admin = RosAdmin(rover, estop)
     rover.add_feature(admin)
     estop.on_engage(admin.on_estop)

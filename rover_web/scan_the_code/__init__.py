@@ -11,13 +11,22 @@
 
 from __future__ import annotations
 
-from rover_web.core.state import Rover
+from rover_web.core.fleet import Fleet
+from rover_web.core.state import Rover, current_feature
 
 from . import routes
 from .service import CODE_CHANNEL, STATE_CHANNEL, ScanTheCodeService, sequence_from_config
 
 
-def init_app(app, rover: Rover) -> None:
+def init_app(app, fleet: Fleet) -> None:
+    for rover in fleet:
+        _init_robot(rover)
+    app.register_blueprint(routes.bp)
+    # The panel renders with the state already in it; SSE keeps it current.
+    app.add_template_global(lambda: current_feature(ScanTheCodeService).snapshot(), "light_sequence_state")
+
+
+def _init_robot(rover: Rover) -> None:
     # Imported here: the package is imported for light_sequence alone (simulator, unit tests),
     # which must not need std_msgs.
     from . import msgs
@@ -32,7 +41,4 @@ def init_app(app, rover: Rover) -> None:
                             lambda msg: service.observe(msgs.text_of(msg)),
                             qos=config["ROVER_WEB_LIGHT_SEQUENCE_QOS"])
     rover.every(service.freshness_period_s, service.check_fresh, name="light-sequence-freshness")
-    app.register_blueprint(routes.bp)
-    # The panel renders with the state already in it; SSE keeps it current.
-    app.add_template_global(service.snapshot, "light_sequence_state")
     rover.add_panel(30, "panels/scan_the_code.html", "Scan the Code", channels=(STATE_CHANNEL,))

@@ -2,9 +2,27 @@
 
 from __future__ import annotations
 
+import math
+
 from rover_web.ros.convert import stamp_to_float, yaw_from_quaternion
 
 ODOMETRY = "nav_msgs/msg/Odometry"
+BATTERY_STATE = "sensor_msgs/msg/BatteryState"
+# sensor_msgs/BatteryState power_supply_status
+SUPPLY_STATUS = {1: "charging", 2: "discharging", 3: "not charging", 4: "full"}
+
+
+def battery_summary(msg) -> dict:
+    """The level a person reads; a field the driver left NaN (unknown) becomes None, never NaN."""
+    def known(value: float, scale: float = 1.0, digits: int = 2):
+        return round(value * scale, digits) if math.isfinite(value) else None
+
+    return {
+        "percent": known(msg.percentage, 100.0, 1),
+        "voltage": known(msg.voltage),
+        "status": SUPPLY_STATUS.get(msg.power_supply_status, "unknown"),
+        "stamp": stamp_to_float(msg.header.stamp),
+    }
 
 
 def odom_summary(msg) -> dict:

@@ -18,6 +18,7 @@ import logging
 
 from flask_sock import Sock
 
+from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
 
@@ -28,9 +29,9 @@ from .websocket import FrameReader
 log = logging.getLogger(__name__)
 
 
-def init_app(app, rover: Rover) -> None:
-    teleop = TeleopService(rover, rover.feature(EStopService))
-    rover.add_feature(teleop)
+def init_app(app, fleet: Fleet) -> None:
+    for rover in fleet:
+        _init_robot(rover)
     # FrameReader: simple_websocket does the handshake, then our reader thread reads the frames
     # (websocket.py, ws_frames.py); TeleopSocket sends the pings.
     app.config["SOCK_SERVER_OPTIONS"] = {"ping_interval": None, "thread_class": FrameReader}
@@ -40,6 +41,11 @@ def init_app(app, rover: Rover) -> None:
     sock.route("/ws/teleop")(routes.teleop_socket)  # on the app: the blueprint is shared by every app
     app.register_blueprint(routes.bp)  # with the dashboard card's context (teleop_state)
 
+
+def _init_robot(rover: Rover) -> None:
+    """Each robot: its own controller, so deadman, operator and re-arming are per robot."""
+    teleop = TeleopService(rover, rover.feature(EStopService))
+    rover.add_feature(teleop)
     rover.hub.register(CHANNEL)
     rover.hub.publish_throttled(CHANNEL, teleop.controller.state(), CHANNEL_MAX_HZ)
     rover.add_panel(5, "panels/teleop.html", "Drive", channels=(CHANNEL,))

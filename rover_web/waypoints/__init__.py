@@ -17,7 +17,8 @@ and imports change only the stored mission; the robot gets them with "send missi
 
 from __future__ import annotations
 
-from rover_web.core.state import Rover
+from rover_web.core.fleet import Fleet
+from rover_web.core.state import Rover, current_feature
 from rover_web.estop import EStopService
 from rover_web.geofence import GeofenceService
 
@@ -26,16 +27,21 @@ from .msgs import NAV_SAT_FIX, fix_reading
 from .service import FIX_CHANNEL, WaypointsService
 
 
-def init_app(app, rover: Rover) -> None:
+def init_app(app, fleet: Fleet) -> None:
+    for rover in fleet:
+        _init_robot(rover)
+    app.register_blueprint(routes.bp)
+    app.context_processor(lambda: {"waypoints_panel": current_feature(WaypointsService).panel_context})
+
+
+def _init_robot(rover: Rover) -> None:
     service = WaypointsService(rover, rover.feature(EStopService), rover.feature(GeofenceService))
     rover.add_feature(service)
-    app.register_blueprint(routes.bp)
     rover.hub.register(broadcaster.CHANNEL, FIX_CHANNEL)
     rover.runtime.subscribe(NAV_SAT_FIX, rover.config["ROVER_WEB_FIX_TOPIC"],
                             lambda msg: service.on_fix(fix_reading(msg)), qos="sensor_data")
     service.broadcaster.start()
     rover.on_shutdown(service.broadcaster.stop)
     rover.on_shutdown(service.store.close)  # runs first: queued changes commit before the db closes
-    app.context_processor(lambda: {"waypoints_panel": service.panel_context})
     rover.add_panel(20, "panels/waypoints.html", "GPS waypoints", channels=(broadcaster.CHANNEL, FIX_CHANNEL))
     rover.add_nav("Waypoints", "/waypoints")

@@ -5,6 +5,13 @@
 // A request that got no answer rejects with fetch's own TypeError, not an ApiError: pages say
 // "refused" and "not reached" differently, and `instanceof ApiError` tells them apart.
 
+// The page's robot: /robots/<name> when it was served under a robot's prefix (several robots),
+// '' otherwise. Every path a page asks for is under it, so a page drives the robot it shows.
+export const base = (typeof document !== 'undefined' && document.body && document.body.dataset.base) || '';
+
+// A root-relative path ('/api/teleop') under the page's robot.
+export const at = (path) => (path.startsWith('/') ? base + path : path);
+
 export class ApiError extends Error {
   constructor(status, code, message, reply = null) {
     super(message);
@@ -41,7 +48,7 @@ export async function api(method, url, body) {
     init.headers['Content-Type'] = 'application/json';
     init.body = typeof body === 'string' ? body : JSON.stringify(body);
   }
-  const response = await fetch(url, init);
+  const response = await fetch(at(url), init);
   if (!response.ok) throw await errorFrom(response);
   const reply = await readJSON(response);
   if (reply === undefined) {

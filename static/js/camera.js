@@ -2,7 +2,7 @@
 // while the tab is hidden, so the server can remove its subscription, and it is only requested
 // for topics the ROS graph lists as images, so a missing camera is a message, not a failed request.
 
-import { api } from './api.js';
+import { api, at } from './api.js';
 
 const card = document.getElementById('camera-card');
 const STORAGE_KEY = 'rover_web.camera.topic';
@@ -48,7 +48,7 @@ if (card) {
       recheckTimer = setTimeout(refreshTopics, RECHECK_MS);
       return;
     }
-    const url = `/stream?${query(topic)}&width=640`;
+    const url = at(`/stream?${query(topic)}&width=640`);
     if (streaming === url) return;
     streaming = url;
     say(`connecting to ${topic}…`);
@@ -71,8 +71,8 @@ if (card) {
     localStorage.setItem(STORAGE_KEY, name);
     ensureOption(name);
     select.value = name;
-    snapshotLink.href = `/snapshot?${query(name)}`;
-    openLink.href = `/stream?${query(name)}`;
+    snapshotLink.href = at(`/snapshot?${query(name)}`);
+    openLink.href = at(`/stream?${query(name)}`);
     streaming = null;
     start();
   }

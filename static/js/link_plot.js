@@ -2,6 +2,7 @@
 // times a GET /api/ping (browser↔server round trip) and reads the age of the newest message on
 // the link topics from the status; both are plotted in ms over the last 5 minutes (log scale: a
 // 3 ms round trip and a 4 s silence both stay readable).
+import { at } from './api.js';
 import { on } from './live.js';
 
 const KEEP = 300;
@@ -51,7 +52,7 @@ on('status', async (status) => {
   let rttMs = null;
   try {
     const start = performance.now();
-    const response = await fetch('/api/ping', { cache: 'no-store' });
+    const response = await fetch(at('/api/ping'), { cache: 'no-store' });
     await response.arrayBuffer();
     if (response.ok) rttMs = Math.max(0.1, performance.now() - start);
   } catch { /* not reached: a gap in the line */ }

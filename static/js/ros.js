@@ -1,7 +1,7 @@
 // The /ros page: each node's parameters as a form with the right input per type, service buttons
 // (std_srvs Trigger, SetBool, Empty) and forms generated from a type's fields, action goals with
 // their live feedback (one EventSource per running goal) and a cancel button.
-import { api, ApiError } from './api.js';
+import { api, ApiError, at } from './api.js';
 
 const BUTTON_TYPES = new Set(['std_srvs/srv/Trigger', 'std_srvs/srv/Empty', 'std_srvs/srv/SetBool']);
 const el = (tag, props = {}, ...children) => {
@@ -199,7 +199,7 @@ function watchGoal(li, goal) {
     try { await api('POST', `/api/actions/${goal.goal_id}/cancel`, {}); } catch (err) { status.textContent = failure(err); }
   });
   li.replaceChildren(el('code', { textContent: goal.action || '' }), ' ', status, ' ', cancel, feedback);
-  const source = new EventSource(`/api/actions/${goal.goal_id}/events`);
+  const source = new EventSource(at(`/api/actions/${goal.goal_id}/events`));
   const show = (data) => {
     if (data.action) li.querySelector('code').textContent = data.action;
     if (data.status) { status.textContent = data.status; li.dataset.status = data.status; }

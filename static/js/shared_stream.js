@@ -23,9 +23,11 @@
 //   event {channel, data, id}
 //   snapshot {to, events}   the current value of each conflated channel, for a tab that joined
 
+import { base } from './api.js';
 import { Source, duplicateFilter } from './stream_source.js';
 
-const NAME = 'rover_web-sse';
+// Per robot: tabs of different robots (/robots/<name>/...) must never share one robot's events.
+const NAME = `rover_web-sse${base}`;
 // Channels the server puts in its ring (hub.emit) instead of conflating: every event counts, so a
 // tab that joins is not handed an old one as if it were new. tests/unit/events/test_ring_channels.py
 // checks this against the server's code.

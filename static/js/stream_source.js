@@ -4,6 +4,8 @@
 // Opening again (more channels, a silent stream) passes the last event id, so the server replays
 // the ring events (scan_code, panel_log) sent in between instead of losing them; the conflated
 // channels come back as a snapshot either way.
+import { at } from './api.js';
+
 export class Source {
   constructor(onEvent, onTrouble, lastId = '') {
     this.onEvent = onEvent;      // (channel, data, id)
@@ -42,7 +44,7 @@ export class Source {
 
   url() {
     const since = this.lastId ? `&lastEventId=${encodeURIComponent(this.lastId)}` : '';
-    return `/api/events?channels=${[...this.channels].join(',')}${since}`;
+    return at(`/api/events?channels=${[...this.channels].join(',')}${since}`);
   }
 
   // A shared stream asks for every tab's channels, so one tab asking for a name this server does

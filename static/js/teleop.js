@@ -6,6 +6,7 @@
 // pagehide and blur. After a stop it did not ask for (deadman, e-stop, takeover), the server sends
 // a new epoch; frames carrying the old one are dropped, so only input sent after that notice moves
 // the robot again.
+import { base } from './api.js';
 import { on } from './live.js';
 import { operatorName, setOperatorName } from './operator.js';
 import { startGamepad } from './teleop_gamepad.js';
@@ -172,7 +173,7 @@ function start() {
 
   function connect() {
     const scheme = location.protocol === 'https:' ? 'wss:' : 'ws:';
-    ws = new WebSocket(`${scheme}//${location.host}/ws/teleop?name=${encodeURIComponent(operatorName())}`);
+    ws = new WebSocket(`${scheme}//${location.host}${base}/ws/teleop?name=${encodeURIComponent(operatorName())}`);
     ws.onmessage = (ev) => {
       let m;
       try { m = JSON.parse(ev.data); } catch { return; }

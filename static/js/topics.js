@@ -1,7 +1,7 @@
 // Topic browser: the live topic list (`topics` channel) and an echo of the chosen topic
 // (its own EventSource on /api/topics/echo, closed when another topic is chosen or the tab is
 // hidden, so the server removes the subscription when nobody looks).
-import { errorFrom } from './api.js';
+import { at, errorFrom } from './api.js';
 import { on } from './live.js';
 
 const body = document.getElementById('topics-body');
@@ -27,7 +27,7 @@ function row(t) {
   tr.dataset.topic = t.name;
   if (t.name === selected) tr.setAttribute('aria-selected', 'true');
   const link = document.createElement('a');
-  link.href = `/topics?topic=${encodeURIComponent(t.name)}`;
+  link.href = at(`/topics?topic=${encodeURIComponent(t.name)}`);
   link.dataset.topic = t.name;
   link.textContent = t.name;
   const name = document.createElement('td');
@@ -71,7 +71,7 @@ function showStats(d) {
   $('echo-count').textContent = String(s.count);
   const isImage = imageTypes.has(d.type);
   $('echo-stream').hidden = !isImage;
-  if (isImage) $('echo-stream-link').href = `/stream?topic=${encodeURIComponent(d.topic)}`;
+  if (isImage) $('echo-stream-link').href = at(`/stream?topic=${encodeURIComponent(d.topic)}`);
 }
 
 function showError(text) {
@@ -98,7 +98,7 @@ async function explainFailure(url) {
   setTimeout(() => { if (url === currentUrl()) openEcho(); }, 2000);
 }
 
-function currentUrl() { return `/api/topics/echo?topic=${encodeURIComponent(selected)}`; }
+function currentUrl() { return at(`/api/topics/echo?topic=${encodeURIComponent(selected)}`); }
 
 function openEcho() {
   closeEcho();
@@ -121,7 +121,7 @@ function openEcho() {
 function select(name) {
   if (name === selected && source) return;
   selected = name;
-  history.replaceState(null, '', `/topics?topic=${encodeURIComponent(name)}`);
+  history.replaceState(null, '', at(`/topics?topic=${encodeURIComponent(name)}`));
   markSelected();
   $('echo-empty').hidden = true;
   $('echo-body').hidden = false;

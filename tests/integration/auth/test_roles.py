@@ -15,6 +15,7 @@ GEOJSON = {"type": "FeatureCollection", "features": [
 # (method, path, body, the least role that may, the rule it exercises). Run in this order.
 REQUESTS = [
     ("POST", "/api/estop", {"engaged": True}, "viewer", "/api/estop"),
+    ("POST", "/api/estop/all", {}, "viewer", "/api/estop/all"),
     ("POST", "/api/estop", {"engaged": False}, "operator", "/api/estop"),
     ("POST", "/api/teleop", {"command": "stop"}, "operator", "/api/teleop"),
     ("POST", "/api/maps/{map}/goal", {"x": 0.0, "y": 0.0}, "operator", "/api/maps/<name>/goal"),
