@@ -21,7 +21,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--port", type=int, default=None, help="port (default ROVER_WEB_PORT, 5000)")
     parser.add_argument("--domain-id", type=int, default=None,
                         help="ROS domain for both (default: ROS_DOMAIN_ID, else a private 42)")
+    parser.add_argument("--robots", default=None, metavar="NAMES",
+                        help="several simulated robots, e.g. boat,rover,drone: each in its own namespace, "
+                             "the GUI serves them all (sets ROVER_WEB_ROBOTS)")
     args, sim_args = parser.parse_known_args(argv)
+    if args.robots:
+        os.environ["ROVER_WEB_ROBOTS"] = args.robots
+        sim_args = ["--robots", args.robots, *sim_args]
 
     # Keep the demo's DDS traffic on this machine unless the operator chose otherwise.
     os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")

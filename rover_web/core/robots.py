@@ -52,11 +52,17 @@ def kind_from_name(name: str) -> str:
 
 
 def from_text(text: str) -> Any:
-    """The environment form: JSON, or the short form "boat,rover,drone" (namespace /<name> each)."""
+    """The environment form: JSON, or the short form "boat,rover,alpha:drone" (namespace /<name>
+    each, the kind after a colon or from the name), as `python -m rover_web.sim --robots` takes it."""
     stripped = text.strip()
     if stripped.startswith("["):
         return stripped  # left to the JSON reader
-    return [{"name": part.strip()} for part in stripped.split(",") if part.strip()]
+    robots = []
+    for part in (p.strip() for p in stripped.split(",")):
+        if part:
+            name, colon, kind = part.partition(":")
+            robots.append({"name": name.strip(), **({"kind": kind.strip()} if colon else {})})
+    return robots
 
 
 def parse(value: Any) -> list[Robot]:
