@@ -42,7 +42,7 @@ def kind_from_name(name: str) -> str:
 
 
 def parse_robot(text: str) -> Robot:
-    name, sep, kind = text.strip().partition(":")
+    name, sep, kind = text.strip(" ").partition(":")
     if not NAME.match(name):
         raise ValueError(f"robot name {name!r} must be lower-case letters, digits and _, starting with a letter")
     if not sep:
