@@ -41,14 +41,16 @@ def test_boat_and_drone_run_in_their_namespaces_and_driving_the_boat_moves_only_
     }
     root = ["/cmd_vel", "/odom", "/fix", "/status", "/control_phase", "/camera/image_raw", "/light_sequence",
             "/diagnostics", "/drone/cmd_vel", "/drone/odom", "/boat/status", "/boat/camera/image_raw"]
-    # Graph discovery lags data: wait until every namespaced endpoint is seen, then look for stray ones.
+    nodes = {"/boat/sim_rover", "/boat/light_buoy", "/drone/sim_drone", "/drone/sim_camera"}
+    # Graph discovery lags data (node names later still): wait until every namespaced endpoint and
+    # node is seen, then look for stray ones.
     graph = wait_until(lambda: (g := peer.graph(count_topics=[*namespaced, *root]))
-                       and all(g[side][topic] >= 1 for topic, side in namespaced.items()) and g,
-                       20, "every namespaced topic of the boat and the drone")
+                       and all(g[side][topic] >= 1 for topic, side in namespaced.items())
+                       and nodes <= set(g["nodes"]) and g,
+                       20, "every namespaced topic and node of the boat and the drone")
     assert {t: (graph["publishers"][t], graph["subscribers"][t]) for t in root} == {t: (0, 0) for t in root}
     strays = [t for t in graph["topics"] if t not in ROS_OWN and not t.startswith(("/boat/", "/drone/"))]
     assert strays == []
-    assert {"/boat/sim_rover", "/boat/light_buoy", "/drone/sim_drone", "/drone/sim_camera"} <= set(graph["nodes"])
 
     assert abs(start["msg"]["twist"]["twist"]["linear"]["x"]) < 1e-9  # at rest until commanded
     peer.advertise("/boat/cmd_vel", "geometry_msgs/msg/Twist")
