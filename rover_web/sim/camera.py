@@ -62,9 +62,10 @@ class PatternFrames:
 
 
 class CameraSim(Node):
-    def __init__(self, *, context=None, topic: str = "/camera/image_raw", width: int = 640, height: int = 480,
-                 rate_hz: float = 30.0, qos: str = "default", frame_id: str = "camera", noise: float = 0.0):
-        super().__init__("sim_camera", context=context)
+    def __init__(self, *, context=None, topic: str = "camera/image_raw", width: int = 640, height: int = 480,
+                 rate_hz: float = 30.0, qos: str = "default", frame_id: str = "camera", noise: float = 0.0,
+                 namespace: str = "/"):
+        super().__init__("sim_camera", namespace=namespace, context=context)
         self.frames = PatternFrames(width, height, noise=noise)
         self.frame_id = frame_id
         self.count = 0
@@ -90,7 +91,8 @@ class CameraSim(Node):
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("camera")
-    group.add_argument("--camera-topic", default="/camera/image_raw", help="image topic (default /camera/image_raw)")
+    group.add_argument("--camera-topic", default="camera/image_raw",
+                       help="image topic (default camera/image_raw, in the robot's namespace)")
     group.add_argument("--camera-size", type=int, nargs=2, metavar=("W", "H"), default=(640, 480),
                        help="image size in pixels (default 640 480)")
     group.add_argument("--camera-hz", type=float, default=30.0, help="frames per second (default 30)")
@@ -103,13 +105,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                             "real camera's")
 
 
-def from_arguments(args: argparse.Namespace, context) -> CameraSim:
+def from_arguments(args: argparse.Namespace, context, namespace: str = "/", east_offset_m: float = 0.0) -> CameraSim:
     width, height = args.camera_size
     if not (16 <= width <= 8192 and 16 <= height <= 8192) or not 0 < args.camera_hz <= 120 \
             or not 0 <= args.camera_noise <= 128:
         raise SystemExit("camera: size must be 16..8192 pixels a side, --camera-hz in (0, 120], --camera-noise 0..128")
     return CameraSim(context=context, topic=args.camera_topic, width=width, height=height, rate_hz=args.camera_hz,
-                     qos=args.camera_qos, noise=args.camera_noise)
+                     qos=args.camera_qos, noise=args.camera_noise, namespace=namespace)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -4,7 +4,8 @@ Subscribes /control_phase (std_msgs/Int8: 1 take off, 2 return, 0 stop), /flight
 (Int8: fly to that AprilTag) and /flight_height (Int8: altitude in metres for the next climb);
 publishes /status (String: Standby, Flying, Hovering), /id (Int8: the tag below, -1 between tags),
 /location (geometry_msgs/Point: metres from the home pad) and /flight_height (its altitude
-setting) at a steady rate, and at once on every change.
+setting) at a steady rate, and at once on every change. The names are relative: /status at the
+root, /drone/status in a robot's namespace (`--robots drone`).
 
     Standby --take off--> Flying --> Hovering (above the pad, tag 0)
     Hovering --destination k--> Flying --> Hovering above tag k
@@ -160,19 +161,20 @@ class OwnEcho:
 
 
 class DroneSim(Node):
-    def __init__(self, *, context=None, transition_s: float = 3.0, rate_hz: float = 5.0, height_m: int = 5):
-        super().__init__("sim_drone", context=context)
+    def __init__(self, *, context=None, transition_s: float = 3.0, rate_hz: float = 5.0, height_m: int = 5,
+                 namespace: str = "/"):
+        super().__init__("sim_drone", namespace=namespace, context=context)
         self.model = DroneModel(transition_s=transition_s, height_m=height_m)
         self._echo = OwnEcho()
         self._lock = threading.Lock()  # the executor is multi-threaded; one command at a time
         command_qos = qos.profile("default")
-        self.create_subscription(Int8, "/control_phase", self._on_control_phase, command_qos)
-        self.create_subscription(Int8, "/flight_destination", self._on_destination, command_qos)
-        self.create_subscription(Int8, "/flight_height", self._on_height, command_qos)
-        self.status_pub = self.create_publisher(String, "/status", 10)
-        self.id_pub = self.create_publisher(Int8, "/id", 10)
-        self.location_pub = self.create_publisher(Point, "/location", 10)
-        self.height_pub = self.create_publisher(Int8, "/flight_height", 10)
+        self.create_subscription(Int8, "control_phase", self._on_control_phase, command_qos)
+        self.create_subscription(Int8, "flight_destination", self._on_destination, command_qos)
+        self.create_subscription(Int8, "flight_height", self._on_height, command_qos)
+        self.status_pub = self.create_publisher(String, "status", 10)
+        self.id_pub = self.create_publisher(Int8, "id", 10)
+        self.location_pub = self.create_publisher(Point, "location", 10)
+        self.height_pub = self.create_publisher(Int8, "flight_height", 10)
         self.create_timer(1.0 / rate_hz, self._tick)
 
     def _command(self, apply, value: int) -> None:
@@ -217,12 +219,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                        help="flight height in metres until /flight_height sets another (default 5)")
 
 
-def from_arguments(args: argparse.Namespace, context) -> DroneSim:
+def from_arguments(args: argparse.Namespace, context, namespace: str = "/", east_offset_m: float = 0.0) -> DroneSim:
     if not args.drone_transition_s > 0 or not args.drone_rate_hz > 0 or not 1 <= args.drone_height <= 127:
         raise SystemExit("drone: --drone-transition-s and --drone-rate-hz must be positive, "
                          "--drone-height from 1 to 127")
     return DroneSim(context=context, transition_s=args.drone_transition_s, rate_hz=args.drone_rate_hz,
-                    height_m=args.drone_height)
+                    height_m=args.drone_height, namespace=namespace)
 
 
 def main(argv: list[str] | None = None) -> None:

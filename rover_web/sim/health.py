@@ -18,6 +18,7 @@ GPS_DROP_EVERY_S, GPS_DROP_FOR_S = 70, 8
 
 @dataclass
 class HealthModel:
+    node: str = "sim_rover"  # names the statuses, as diagnostic_updater does ("node: task")
     t: int = 0  # seconds since start
 
     def battery_v(self) -> float:
@@ -34,14 +35,14 @@ class HealthModel:
         temp_c = 71.5 if hot else 42.0
         no_rtk = t % GPS_DROP_EVERY_S >= GPS_DROP_EVERY_S - GPS_DROP_FOR_S
         statuses = [
-            {"name": "sim_rover: battery", "hardware_id": "battery", "level": battery_level,
+            {"name": f"{self.node}: battery", "hardware_id": "battery", "level": battery_level,
              "message": {OK: "ok", WARN: "low", ERROR: "critically low"}[battery_level],
              "values": {"voltage_V": f"{volts:.2f}", "percent": f"{100 * (volts - 22.0) / 3.2:.0f}"}},
-            {"name": "sim_rover: left motor", "hardware_id": "motor_controller", "level": WARN if hot else OK,
+            {"name": f"{self.node}: left motor", "hardware_id": "motor_controller", "level": WARN if hot else OK,
              "message": "running hot" if hot else "ok", "values": {"temperature_C": f"{temp_c:.1f}"}},
-            {"name": "sim_rover: right motor", "hardware_id": "motor_controller", "level": OK, "message": "ok",
+            {"name": f"{self.node}: right motor", "hardware_id": "motor_controller", "level": OK, "message": "ok",
              "values": {"temperature_C": "41.0"}},
-            {"name": "sim_rover: gps", "hardware_id": "gps", "level": WARN if no_rtk else OK,
+            {"name": f"{self.node}: gps", "hardware_id": "gps", "level": WARN if no_rtk else OK,
              "message": "no RTK corrections: float fix" if no_rtk else "RTK fixed",
              "values": {"fix": "float" if no_rtk else "rtk_fixed", "satellites": "9" if no_rtk else "17"}},
         ]

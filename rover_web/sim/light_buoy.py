@@ -75,9 +75,12 @@ class BuoyClock:
 class LightBuoy(Node):
     def __init__(self, *, context=None, colours: Sequence[str] = DEFAULT_COLOURS, period_s: float = 1.0,
                  black_s: float | None = None, rate_hz: float = 10.0, drop: float = 0.0, noise: float = 0.0,
-                 new_code_every: int = 0, seed: int | None = None, topic: str = "/light_sequence",
-                 answer_topic: str = "/light_buoy/answer", request_topic: str = "/light_buoy/new_code"):
-        super().__init__("light_buoy", context=context)
+                 new_code_every: int = 0, seed: int | None = None, topic: str = "light_sequence",
+                 answer_topic: str = "light_buoy/answer", request_topic: str = "light_buoy/new_code",
+                 namespace: str = "/"):
+        super().__init__("light_buoy", namespace=namespace, context=context)
+        # Which buoy a printed line is about, when several boats run: " (/boat)"; nothing at the root.
+        self._whose = "" if namespace == "/" else f" ({namespace})"
         self.colours = parse_colours(colours)
         self.rng = random.Random(seed)
         self.drop, self.noise, self.new_code_every = drop, noise, new_code_every
@@ -105,7 +108,7 @@ class LightBuoy(Node):
     def _tick(self) -> None:
         now = time.monotonic()
         if not self._announced:
-            print(f"light buoy code: {','.join(self.clock.code)}", flush=True)
+            print(f"light buoy code: {','.join(self.clock.code)}{self._whose}", flush=True)
             self._announced = True
         before = self.clock.cycles
         self.clock.advance(now)
@@ -125,7 +128,8 @@ class LightBuoy(Node):
         self.sent += 1
 
     def destroy_node(self) -> None:
-        print(f"light buoy stopped: {self.sent} sent, {self.dropped} dropped, {self.misread} misread", flush=True)
+        print(f"light buoy stopped{self._whose}: {self.sent} sent, {self.dropped} dropped, {self.misread} misread",
+              flush=True)
         super().destroy_node()
 
 
@@ -167,13 +171,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--buoy-new-code-every", type=int, default=0, metavar="N",
                        help="choose a new code every N cycles (default 0: only on request)")
     group.add_argument("--buoy-seed", type=int, default=None, help="random seed, for repeatable codes and drops")
-    group.add_argument("--buoy-topic", default="/light_sequence", help="topic the colours go to")
+    group.add_argument("--buoy-topic", default="light_sequence",
+                       help="topic the colours go to (default light_sequence, in the robot's namespace)")
 
 
-def from_arguments(args: argparse.Namespace, context) -> LightBuoy:
+def from_arguments(args: argparse.Namespace, context, namespace: str = "/", east_offset_m: float = 0.0) -> LightBuoy:
     return LightBuoy(context=context, colours=args.buoy_colours, period_s=args.buoy_period,
                      black_s=args.buoy_black, rate_hz=args.buoy_rate, drop=args.buoy_drop, noise=args.buoy_noise,
-                     new_code_every=max(0, args.buoy_new_code_every), seed=args.buoy_seed, topic=args.buoy_topic)
+                     new_code_every=max(0, args.buoy_new_code_every), seed=args.buoy_seed, topic=args.buoy_topic,
+                     namespace=namespace)
 
 
 def main(argv: list[str] | None = None) -> None:

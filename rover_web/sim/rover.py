@@ -1,4 +1,7 @@
-"""A simulated differential-drive rover: integrates /cmd_vel, publishes /odom, /amcl_pose and /fix.
+"""A simulated differential-drive rover: integrates cmd_vel, publishes odom, amcl_pose and fix.
+
+Topic names are relative, so in the root namespace they are /cmd_vel, /odom, ... and in a robot's
+namespace (`--robots`) /boat/cmd_vel, /boat/odom, ...
 
 Like a real base it stops by itself when commands stop for `cmd_timeout_s`. Its GPS fix is its
 map pose laid on a local tangent plane around a configurable origin (by default Nathan
@@ -31,6 +34,7 @@ from rover_web.ros import qos
 from rover_web.ros.convert import quaternion_from_yaw, yaw_from_quaternion
 
 from .health import HealthModel
+from .robots import SPACING_EAST_M
 
 EARTH_RADIUS_M = 6378137.0
 BENDERSON_LAT = 27.3742443
@@ -162,19 +166,20 @@ _LOG = {
 class RoverSim(Node):
     def __init__(self, *, context=None, x: float = 0.0, y: float = 0.0, yaw: float = 0.0,
                  stamped: bool = False, lat0: float = BENDERSON_LAT, lon0: float = BENDERSON_LON,
-                 rate_hz: float = 50.0, goal_topic: str = "/goal_pose", goal_speed_mps: float = 0.5):
-        super().__init__("sim_rover", context=context)
+                 rate_hz: float = 50.0, goal_topic: str = "goal_pose", goal_speed_mps: float = 0.5,
+                 namespace: str = "/"):
+        super().__init__("sim_rover", namespace=namespace, context=context)
         self.drive = DiffDrive(x, y, yaw)
         self.follower = GoalFollower(max_linear_mps=goal_speed_mps)
         self.lat0, self.lon0 = lat0, lon0
         if stamped:
-            self.create_subscription(TwistStamped, "/cmd_vel", lambda m: self._on_cmd(m.twist), 10)
+            self.create_subscription(TwistStamped, "cmd_vel", lambda m: self._on_cmd(m.twist), 10)
         else:
-            self.create_subscription(Twist, "/cmd_vel", self._on_cmd, 10)
-        self.odom_pub = self.create_publisher(Odometry, "/odom", 10)
-        self.pose_pub = self.create_publisher(PoseWithCovarianceStamped, "/amcl_pose", qos.profile("latched"))
-        self.fix_pub = self.create_publisher(NavSatFix, "/fix", 10)
-        self.plan_pub = self.create_publisher(Path, "/plan", 1)
+            self.create_subscription(Twist, "cmd_vel", self._on_cmd, 10)
+        self.odom_pub = self.create_publisher(Odometry, "odom", 10)
+        self.pose_pub = self.create_publisher(PoseWithCovarianceStamped, "amcl_pose", qos.profile("latched"))
+        self.fix_pub = self.create_publisher(NavSatFix, "fix", 10)
+        self.plan_pub = self.create_publisher(Path, "plan", 1)
         self.create_subscription(PoseStamped, goal_topic, self._on_goal, 10)
         self._dt = 1.0 / rate_hz
         self._ticks = 0
@@ -182,8 +187,9 @@ class RoverSim(Node):
         self.create_timer(self._dt, self._tick)
         # Diagnostics and log lines at every level, once a second, so the demo's /diagnostics and
         # /logs show something (rclpy nodes log to /rosout).
-        self.health = HealthModel()
-        self.diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
+        # Named after the node with its namespace, so an operator reading a merged list knows which robot.
+        self.health = HealthModel(node=self.get_fully_qualified_name().lstrip("/"))
+        self.diag_pub = self.create_publisher(DiagnosticArray, "diagnostics", 10)
         self.get_logger().set_level(LoggingSeverity.DEBUG)
         self.create_timer(1.0, self._health)
 
@@ -201,7 +207,7 @@ class RoverSim(Node):
 
     def _on_cmd(self, twist) -> None:
         if self.follower.cancel():
-            self.get_logger().info("operator command on /cmd_vel: goal cancelled")
+            self.get_logger().info("operator command on cmd_vel: goal cancelled")
             self.plan_pub.publish(self._plan(None))
         self.drive.command(twist.linear.x, twist.angular.z, time.monotonic())
 
@@ -298,11 +304,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--stamped", action="store_true", help="expect geometry_msgs/TwistStamped on /cmd_vel")
     group.add_argument("--start", type=float, nargs=3, metavar=("X", "Y", "YAW"), default=None,
                        help="start pose in the map frame (metres, radians); default: the first waypoint "
-                            "of the first map in --maps-file")
+                            "of the first map in --maps-file. With --robots, each further boat or rover "
+                            f"starts {SPACING_EAST_M:g} m east of the one before")
     group.add_argument("--maps-file", default=None,
                        help="all_maps.json or map_server yaml the default start comes from "
                             "(default: $ROVER_WEB_MAPS_FILE, else map_files/all_maps.json)")
-    group.add_argument("--goal-topic", default="/goal_pose", help="PoseStamped goals to drive to (frame map)")
+    group.add_argument("--goal-topic", default="goal_pose",
+                       help="PoseStamped goals to drive to (frame map; default goal_pose, in the robot's namespace)")
     group.add_argument("--goal-speed", type=float, default=0.5, metavar="M_PER_S",
                        help="top speed while driving to a goal")
 
@@ -316,10 +324,10 @@ def default_start(maps_file: str | None = None) -> tuple[float, float, float]:
     return first_waypoint_or_centre(first)
 
 
-def from_arguments(args: argparse.Namespace, context) -> RoverSim:
+def from_arguments(args: argparse.Namespace, context, namespace: str = "/", east_offset_m: float = 0.0) -> RoverSim:
     x, y, yaw = args.start if args.start else default_start(args.maps_file)
-    return RoverSim(context=context, x=x, y=y, yaw=yaw, stamped=args.stamped, goal_topic=args.goal_topic,
-                    goal_speed_mps=args.goal_speed)
+    return RoverSim(context=context, x=x + east_offset_m, y=y, yaw=yaw, stamped=args.stamped,
+                    goal_topic=args.goal_topic, goal_speed_mps=args.goal_speed, namespace=namespace)
 
 
 def main(argv: list[str] | None = None) -> None:

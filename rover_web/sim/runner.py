@@ -41,7 +41,8 @@ def run_nodes(make_nodes: Callable[[Context], list]) -> None:
 
     signal.signal(signal.SIGINT, request_stop)
     signal.signal(signal.SIGTERM, request_stop)
-    names = ", ".join(n.get_name() for n in nodes)
+    # Namespaced nodes by their full names: several robots run nodes of the same name.
+    names = ", ".join(n.get_name() if n.get_namespace() == "/" else n.get_fully_qualified_name() for n in nodes)
     print(f"simulator running: {names} (domain {context.get_domain_id()}); Ctrl-C stops it", flush=True)
     spinner = threading.Thread(target=_spin, args=(executor, stop), daemon=True)
     spinner.start()
