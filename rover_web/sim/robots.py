@@ -8,8 +8,9 @@ kind is written `name:kind`, or taken from the name when it starts with a kind (
 from __future__ import annotations
 
 import argparse
-import re
 from dataclasses import dataclass
+
+from rover_web.core import robots as robots_setting
 
 # Which parts each kind runs, in the order they start.
 KIND_PARTS: dict[str, tuple[str, ...]] = {
@@ -18,7 +19,6 @@ KIND_PARTS: dict[str, tuple[str, ...]] = {
     "drone": ("drone", "camera"),
 }
 DEFAULT_KIND = "rover"
-NAME = re.compile(r"[a-z][a-z0-9_]*\Z")
 # Robots that drive (run the rover part) start this far east of each other, so they are apart on the map.
 SPACING_EAST_M = 20.0
 
@@ -38,12 +38,14 @@ class Robot:
 
 
 def kind_from_name(name: str) -> str:
-    return next((kind for kind in KIND_PARTS if name.startswith(kind)), DEFAULT_KIND)
+    """The app's rule (ROVER_WEB_ROBOTS's short form), so both name a robot's kind alike."""
+    kind = robots_setting.kind_from_name(name)
+    return kind if kind in KIND_PARTS else DEFAULT_KIND
 
 
 def parse_robot(text: str) -> Robot:
     name, sep, kind = text.strip(" ").partition(":")
-    if not NAME.match(name):
+    if not robots_setting.NAME_PATTERN.match(name):
         raise ValueError(f"robot name {name!r} must be lower-case letters, digits and _, starting with a letter")
     if not sep:
         return Robot(name, kind_from_name(name))
