@@ -47,4 +47,4 @@ def _halt(worker, full=False):
     if full:
         rover.shutdown()
     else:
-        rover.cmd_vel.halt()
+        rover.fleet.zero_all()  # every robot this worker serves

@@ -75,11 +75,7 @@ def stop_with_process(rover) -> None:
 
         def handler(sig, frame, previous=previous):
             for live in list(_live_rovers):
-                for robot in live.fleet.robots if live.fleet else [live]:  # every robot it serves
-                    try:
-                        robot.cmd_vel.halt()
-                    except Exception:
-                        log.exception("could not stop robot %s", robot.robot.name)
+                live.fleet.zero_all()  # every robot the process serves
             if callable(previous) and previous not in (signal.SIG_IGN, signal.SIG_DFL):
                 return previous(sig, frame)
             if sig == signal.SIGINT:

@@ -90,6 +90,14 @@ class Fleet:
     def names(self) -> list[str]:
         return [rover.robot.name for rover in self.robots]
 
+    def zero_all(self) -> None:
+        """A zero velocity to every robot now (a signal's first act); the ordered stop comes later."""
+        for rover in self.robots:
+            try:
+                rover.cmd_vel.halt()
+            except Exception:
+                log.exception("could not stop robot %s", rover.robot.name)
+
     def shutdown(self) -> None:
         """Every robot to zero first, then the graph's work, each robot's, and ROS last."""
         with self._lock:
