@@ -77,6 +77,8 @@ def build(app: Flask, parts: list[str] | None = None) -> dict[str, Any]:
                     raise ValueError(f"{method.upper()} {key} is described twice (again in {name})")
                 paths.setdefault(key, {})[method] = copy.deepcopy(operation)
     _fill_path_parameters(paths, app)
+    rover = app.extensions.get("rover_web")
+    names = rover.fleet.names if rover is not None and rover.fleet is not None else ["robot"]
     return {
         "openapi": "3.1.0",
         "info": {
@@ -85,7 +87,10 @@ def build(app: Flask, parts: list[str] | None = None) -> dict[str, Any]:
             "description": "The HTTP API of rover_web, a web GUI for ROS 2 robots. Every error is "
                            "`{\"error\": code, \"message\": text}`. See docs/api.md.",
         },
-        "servers": [{"url": "/"}],
+        # Every path is also served for each robot under /robots/<name> (docs/fleet.md).
+        "servers": [{"url": "/", "description": "the first robot"},
+                    {"url": "/robots/{robot}", "description": "one robot of ROVER_WEB_ROBOTS",
+                     "variables": {"robot": {"default": names[0], "enum": names}}}],
         "security": [{"bearerToken": []}, {"sessionCookie": []}],
         "paths": dict(sorted(paths.items())),
         "components": {
