@@ -155,3 +155,29 @@ def test_estop_all_stops_both_and_each_is_released_on_its_own(drive_rig):
                timeout=5, what="the released drone takes a REST command")
     peer.wait_for(CMD_VEL["drone"], lambda m: m["angular"]["z"] == pytest.approx(0.4), timeout=2)
     assert peer.received(ROOT_CMD_VEL) == []
+
+
+def cancel_outcome(url: str) -> dict[str, dict]:
+    outcome = get(url + "/api/estop")["cancel"]
+    return outcome and {o["action"]: o for o in outcome}
+
+
+def test_a_robot_s_estop_cancels_its_own_navigation_goal_only(fleet_server, action_server):
+    server = fleet_server()
+    nav = {name: action_server(f"/{name}/navigate_to_pose") for name in NAMES}
+    for name in NAMES:  # as on a robot, the app's cancel client found the server long before
+        wait_until(lambda name=name: f"/{name}/navigate_to_pose" in get(server.robot[name] + "/api/estop")[
+            "cancellable_actions"], what=f"the {name}'s action server seen by the app")
+        nav[name].send_goal()
+
+    assert post(server.robot["boat"] + "/api/estop", {"engaged": True}).status_code == 200
+    nav["boat"].wait("canceled", timeout=5)
+    boat = wait_until(lambda: cancel_outcome(server.robot["boat"]), what="the boat's cancel outcome")
+    assert (boat["/boat/navigate_to_pose"]["result"], boat["/boat/navigate_to_pose"]["goals"]) == ("canceled", 1)
+    assert "/drone/navigate_to_pose" not in boat
+
+    # The drone's goal was left running: its own e-stop still finds it to cancel.
+    assert post(server.robot["drone"] + "/api/estop", {"engaged": True}).status_code == 200
+    nav["drone"].wait("canceled", timeout=5)
+    drone = wait_until(lambda: cancel_outcome(server.robot["drone"]), what="the drone's cancel outcome")
+    assert (drone["/drone/navigate_to_pose"]["result"], drone["/drone/navigate_to_pose"]["goals"]) == ("canceled", 1)
