@@ -63,6 +63,15 @@ def test_waypoints_go_to_their_robot_s_topic_and_list(fleet_server, ros_peer, tm
     assert mission(boat) == [(10.5, 59.9)]
     assert mission(server.url) == mission(boat)
 
+    # Sending the drone's mission publishes it on /drone/mission (until heard once: discovery).
+    missions = listen(peer, FLOAT64_MULTI_ARRAY, "mission")
+    wait_until(lambda: post(drone + "/api/waypoints/send").ok and peer.received(missions["drone"]), timeout=15,
+               interval=0.1, what="the drone's mission heard")
+    sent = peer.received(missions["drone"])[0]["msg"]
+    assert sent["data"] == [-82.451, 27.371, -82.452, 27.372]
+    time.sleep(SETTLE_S)
+    assert peer.received(missions["boat"]) == [] and peer.received(missions["root"]) == []
+
     # ... kept in its own database file: the first robot's is ROVER_WEB_DB_PATH, the drone's beside it.
     boat_db, drone_db = tmp_path / "fleet.sqlite3", tmp_path / "fleet-drone.sqlite3"
     wait_until(lambda: len(stored_rows(drone_db)) == 2, timeout=5, what="the drone's waypoints stored")
