@@ -121,3 +121,30 @@ def latches(stream) -> list[tuple[bool, str | None]]:
         if not out or out[-1] != latch:
             out.append(latch)
     return out
+
+
+def test_sign_in_and_roles_hold_under_every_robot_s_prefix(app_factory, tmp_path):
+    from tests.support.auth import add_users
+
+    db = tmp_path / "signed.sqlite3"
+    tokens = add_users(db)  # the users live in the first robot's database, for every robot
+    client = app_factory(ROVER_WEB_ROBOTS=ROBOTS, ROVER_WEB_AUTH="required", ROVER_WEB_DB_PATH=str(db)).test_client()
+
+    def as_(role):
+        return {"Authorization": f"Bearer {tokens[role]}"} if role else {}
+
+    for robot in ("boat", "drone"):
+        drive = f"/robots/{robot}/api/teleop"
+        assert client.post(drive, json={"command": "stop"}, headers=as_(None)).status_code == 401
+        assert client.post(drive, json={"command": "stop"}, headers=as_("viewer")).status_code == 403
+        assert client.post(drive, json={"command": "stop"}, headers=as_("operator")).status_code == 200
+        assert client.get(f"/robots/{robot}/api/status", headers=as_(None)).status_code == 401
+        assert client.get(f"/robots/{robot}/api/status", headers=as_("viewer")).status_code == 200
+    # Any signed-in user stops every robot; releasing one takes an operator.
+    assert client.post("/api/estop/all", json={}, headers=as_(None)).status_code == 401
+    stopped = client.post("/api/estop/all", json={}, headers=as_("viewer"))
+    assert stopped.status_code == 200 and all(s["by"] == "viewer" for s in stopped.json["robots"].values())
+    release = {"engaged": False}
+    assert client.post("/robots/drone/api/estop", json=release, headers=as_("viewer")).status_code == 403
+    assert client.post("/robots/drone/api/estop", json=release, headers=as_("operator")).json["engaged"] is False
+    assert client.get("/robots/boat/api/estop", headers=as_("viewer")).json["engaged"] is True
