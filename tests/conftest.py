@@ -230,6 +230,23 @@ def ros_peer():
         peer.close()
 
 
+@pytest.fixture
+def action_server():
+    """make(name): tests/support/peers/action_server.py serving the action `name` in its own process."""
+    from tests.support.action_peer import ActionServerPeer
+
+    made = []
+
+    def make(name):
+        peer = ActionServerPeer(name)
+        made.append(peer)
+        return peer
+
+    yield make
+    for peer in made:
+        peer.close()
+
+
 class SimProcess:
     """`python -m rover_web.sim` (or one part, e.g. module="rover_web.sim.drone") in its own process."""
 

@@ -50,7 +50,12 @@ def json_body(required: bool = True) -> dict:
 
 
 def wants_json(req: Request) -> bool:
-    return req.path.startswith(JSON_PREFIXES) or req.method != "GET" or req.accept_mimetypes.best == "application/json"
+    path = req.path
+    if path.startswith("/robots/"):
+        # /robots/<name>/api/... of a robot that does not exist: rover_web/fleet/prefix.py left the
+        # prefix in the path, and an API client still reads the answer as JSON.
+        path = "/" + path[len("/robots/"):].partition("/")[2]
+    return path.startswith(JSON_PREFIXES) or req.method != "GET" or req.accept_mimetypes.best == "application/json"
 
 
 def host_is_trusted(host: str, trusted: list[str]) -> bool:

@@ -4,7 +4,6 @@ without restarting rover_web: the link, the camera stream, the drone panel's sta
 and driving."""
 
 import signal
-import threading
 import time
 
 import pytest
@@ -12,7 +11,7 @@ import requests
 
 from tests.support.mjpeg import MjpegClient
 from tests.support.panels_support import display
-from tests.support.teleop_support import TeleopClient, is_zero, subscribe_cmd_vel, warm_up
+from tests.support.teleop_support import Stick, is_zero, subscribe_cmd_vel, warm_up
 from tests.support.waiting import wait_until
 
 STALE_S = 1.0
@@ -25,27 +24,6 @@ def status(url):
 def live_pose(url):
     default = requests.get(url + "/api/maps", timeout=5).json()["default"]
     return requests.get(f"{url}/api/maps/{default}", timeout=5).json()["map_parameters"]["current_pose"]
-
-
-class Stick:
-    """A page holding the joystick forward: a frame every 50 ms with the newest epoch it was told."""
-
-    def __init__(self, url):
-        self.client = TeleopClient(url)
-        self.value = 0.4
-        self.refusals: list[str] = []
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True)
-        self._thread.start()
-
-    def _run(self):
-        while not self._stop.wait(0.05):
-            self.client.drive(self.value, 0.0, epoch=self.client.epoch)
-
-    def close(self):
-        self._stop.set()
-        self._thread.join(5)
-        self.client.close()
 
 
 @pytest.mark.ros

@@ -295,3 +295,29 @@ def drive_at(client: TeleopClient, values, rate_hz: float = 40.0, epoch: int | N
             time.sleep(delay)
         times.append(client.drive(linear, angular, epoch=epoch))
     return times
+
+
+class Stick:
+    """A page holding the joystick: a frame every 50 ms, with the newest epoch it was told, until
+    closed; `value` is the linear input it holds (set it to 0.0 to let go)."""
+
+    def __init__(self, url: str, name: str | None = None, value: float = 0.4):
+        self.client = TeleopClient(url, name=name)
+        self.value = value
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        import websocket
+
+        while not self._stop.wait(0.05):
+            try:
+                self.client.drive(self.value, 0.0, epoch=self.client.epoch)
+            except (websocket.WebSocketException, OSError):  # the server ended the socket
+                return
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join(5)
+        self.client.close()

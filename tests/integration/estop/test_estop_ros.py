@@ -2,10 +2,8 @@
 
 import time
 
-import pytest
 import requests
 
-from tests.support.action_peer import ActionServerPeer
 from tests.support.panels_support import (
     drone_sim,  # noqa: F401 (fixture)
     wait_display,
@@ -22,20 +20,6 @@ POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
 
 def post(server, path, body):
     return requests.post(server.url + path, json=body, timeout=5)
-
-
-@pytest.fixture
-def action_server():
-    made = []
-
-    def make(name):
-        peer = ActionServerPeer(name)
-        made.append(peer)
-        return peer
-
-    yield make
-    for peer in made:
-        peer.close()
 
 
 def test_a_late_subscriber_gets_the_latch_and_sees_release(live_server_factory, ros_peer):
