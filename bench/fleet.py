@@ -14,8 +14,9 @@ Reported per N: the server's CPU (% of one core) in each phase; RSS and threads;
 second per viewer (lowest and highest viewer: a starving robot shows as a low minimum); the
 odometry's age on arrival (its wall-clock stamp, set just before the publish, to the kernel's
 receive timestamp of the frame in the viewer's socket; p50, p99, and the worst robot's p99);
-the e-stop/all HTTP round trip and the time until every viewer of every robot had its robot's
-`estop` event; GET /api/robots; every robot's link state; the load generator's lag.
+the e-stop/all HTTP round trip, the time until every viewer of every robot had its robot's
+`estop` event, and until the last robot's /<name>/e_stop said true in ROS (in the load
+generator's process); GET /api/robots; every robot's link state; the load generator's lag.
 
 ODOM_MAX_HZ: by default the app's own (10 Hz) applies, so the 50 Hz odometry reaches a viewer at
 ~10 Hz and a frame is the newest message when the interval is up: its age includes up to one
@@ -27,6 +28,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import threading
@@ -69,10 +71,11 @@ def in_thread(fn) -> tuple[threading.Thread, dict]:
 def estop_rounds(server: Server, fleet: SseFleet, robots: list[str], rounds: int) -> dict:
     """POST /api/estop/all while the viewers read: the HTTP round trip, and when the last viewer
     had its robot's `estop` event with engaged true. Then each robot released, one POST each."""
-    http_ms, all_viewers_ms, missing, errors = [], [], 0, []
+    http_ms, all_viewers_ms, missing, errors, sent_wall = [], [], 0, [], []
     session = requests.Session()
     for _ in range(rounds):
         first: dict = {}
+        sent_wall.append(time.time())
         t_send = time.monotonic()
 
         def engage(t_send=t_send):
@@ -110,7 +113,23 @@ def estop_rounds(server: Server, fleet: SseFleet, robots: list[str], rounds: int
         fleet.poll(0.5, lambda *a: None)
         if "error" in out:
             errors.append(out["error"])
-    return {"http_ms": http_ms, "all_viewers_ms": all_viewers_ms, "missing": missing, "errors": errors}
+    return {"http_ms": http_ms, "all_viewers_ms": all_viewers_ms, "missing": missing, "errors": errors,
+            "sent_wall": sent_wall}
+
+
+def estop_in_ros(sent_wall: list[float], log: list, robots: list[str]) -> tuple[list[float], int]:
+    """Per round: ms from the POST to the last robot's /<name>/e_stop true (the load generator's log)."""
+    took, missing = [], 0
+    for i, t_send in enumerate(sent_wall):
+        t_next = sent_wall[i + 1] if i + 1 < len(sent_wall) else float("inf")
+        arrived = {}
+        for name, engaged, t in log:
+            if engaged and t_send <= t < t_next and name not in arrived:
+                arrived[name] = t
+        missing += len(robots) - len(arrived)
+        if arrived:
+            took.append(1000 * (max(arrived.values()) - t_send))
+    return took, missing
 
 
 def robots_api(server: Server, fleet: SseFleet, times: int = 20) -> tuple[list[float], list[str]]:
@@ -136,7 +155,7 @@ def run(n: int, args, env: dict) -> dict:
     server = Server({**env, **extra}, kind=args.server)
     load: subprocess.Popen | None = None
     fleet: SseFleet | None = None
-    result: dict = {"n": n, "viewers": args.viewers}
+    result: dict = {"n": n, "viewers": args.viewers, "loadavg": [os.getloadavg()[0]]}
     try:
         time.sleep(2.0)  # start-up's own work (first discovery, the first status) is not idle
         result["idle_cpu"] = cpu_pct(server, None, args.idle_seconds)
@@ -184,6 +203,7 @@ def run(n: int, args, env: dict) -> dict:
         result["estop"] = estop_rounds(server, fleet, robots, args.estops)
         result["robots_api_ms"], links = robots_api(server, fleet)
         result["links"] = {state: links.count(state) for state in sorted(set(links))}
+        result["loadavg"].append(os.getloadavg()[0])
         status = requests.get(server.url + "/api/status", timeout=10).json()
         result["callback_errors"] = status.get("callback_errors")
         return result
@@ -197,6 +217,9 @@ def run(n: int, args, env: dict) -> dict:
                 lines = [line for line in out.splitlines() if line.startswith("{")]
                 if lines:
                     result["load"] = json.loads(lines[-1])
+                    if "estop" in result:
+                        result["estop"]["ros_ms"], result["estop"]["ros_missing"] = estop_in_ros(
+                            result["estop"]["sent_wall"], result["load"].pop("estop"), robots)
             except subprocess.TimeoutExpired:
                 load.kill()
                 load.wait(5)
@@ -219,15 +242,18 @@ def describe(r: dict) -> str:
             f"odom age p50 {r['odom_ms'][0]:.1f} p99 {r['odom_ms'][1]:.1f} ms (worst robot p99 "
             f"{r['worst_robot_p99_ms']:.1f}, n={r['odom_events']})  estop/all HTTP p50/max "
             f"{ms_pair(e['http_ms'])} ms, at every viewer {ms_pair(e['all_viewers_ms'])} ms, missed {e['missing']}, "
+            f"every robot's /e_stop true in ROS {ms_pair(e.get('ros_ms', []))} ms, missed {e.get('ros_missing')}, "
             f"errors {e['errors'] or 0}  /api/robots p50 {statistics.median(r['robots_api_ms']):.1f} ms  "
             f"links {r['links']}  silent viewers {r['silent_viewers']}  callback errors {r['callback_errors']}  "
-            f"discovery {r['discovery_s']:.1f} s  load sent {load.get('rates')} late p99 {load.get('late_p99_ms')} ms")
+            f"discovery {r['discovery_s']:.1f} s  machine load average {r['loadavg'][0]:.1f}->{r['loadavg'][-1]:.1f}"
+            f"  load sent {load.get('rates')} late p99 {load.get('late_p99_ms')} ms")
 
 
 def table(results: list[dict]) -> str:
     head = ("| robots | viewers | CPU idle | CPU load only | CPU load + viewers | RSS | threads | odom / viewer | "
             "odom age p50 / p99 (worst robot) | e-stop/all HTTP p50 / max | at every viewer p50 / max | "
-            "/api/robots p50 |")
+            "last robot's /e_stop p50 / max | "
+            "/api/robots p50 | load average |")
     rows = [head, "|" + " --- |" * (head.count("|") - 1)]
     for r in results:
         e = r["estop"]
@@ -235,8 +261,8 @@ def table(results: list[dict]) -> str:
             f"| {r['n']} | {r['n'] * r['viewers']} | {r['idle_cpu']:.1f}% | {r['load_cpu']:.1f}% | {r['cpu']:.1f}% | "
             f"{r['rss']:.0f} MB | {r['threads']} | {r['odom_hz'][0]:.1f}-{r['odom_hz'][1]:.1f} Hz | "
             f"{r['odom_ms'][0]:.1f} / {r['odom_ms'][1]:.1f} ({r['worst_robot_p99_ms']:.1f}) ms | "
-            f"{ms_pair(e['http_ms'])} ms | {ms_pair(e['all_viewers_ms'])} ms | "
-            f"{statistics.median(r['robots_api_ms']):.1f} ms |")
+            f"{ms_pair(e['http_ms'])} ms | {ms_pair(e['all_viewers_ms'])} ms | {ms_pair(e.get('ros_ms', []))} ms | "
+            f"{statistics.median(r['robots_api_ms']):.1f} ms | {r['loadavg'][0]:.1f}-{r['loadavg'][-1]:.1f} |")
     return "\n".join(rows)
 
 

@@ -7,8 +7,10 @@
 Every header is stamped with the wall clock (time.time) just before its publish, for latency.
 Robots are spread evenly over each period (not all published in one burst), as independent
 robots would be. Prints "publishing" once every robot's odometry has a subscriber, and at the end
-one JSON line: messages sent per topic kind, and how far the loop fell behind its schedule (a
-load generator that cannot keep up would make the server look better than it is).
+one JSON line: messages sent per topic kind, how far the loop fell behind its schedule (a
+load generator that cannot keep up would make the server look better than it is), and every
+change of each robot's /<name>/e_stop (std_msgs/Bool) with the wall-clock time it arrived here,
+so the bench can time a "stop all" to the last robot in ROS, not only to the browsers.
 """
 
 from __future__ import annotations
@@ -19,14 +21,17 @@ import json
 import math
 import signal
 import sys
+import threading
 import time
 
 import rclpy
 from nav_msgs.msg import Odometry
 from rclpy.context import Context
-from rclpy.qos import qos_profile_sensor_data
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import BatteryState, NavSatFix
+from std_msgs.msg import Bool
 
 # Where the simulated robots drive (the simulator's origin, Sarasota Bay), and how.
 LAT0, LON0 = 27.3742443, -82.4500873
@@ -38,14 +43,25 @@ def stamp(msg, t_ns: int) -> None:
     msg.header.stamp.sec, msg.header.stamp.nanosec = t_ns // 1_000_000_000, t_ns % 1_000_000_000
 
 
+LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
 class Robot:
-    def __init__(self, node, index: int, name: str):
+    def __init__(self, node, index: int, name: str, estop_log: list):
         self.name = name
+        self.estop: bool | None = None
+        self._estop_log = estop_log
+        node.create_subscription(Bool, f"/{name}/e_stop", self._on_estop, LATCHED)
         self.phase = index * 0.7  # robots are not on top of each other
         self.odom = node.create_publisher(Odometry, f"/{name}/odom", 10)
         self.fix = node.create_publisher(NavSatFix, f"/{name}/fix", qos_profile_sensor_data)
         self.battery = node.create_publisher(BatteryState, f"/{name}/battery_state", qos_profile_sensor_data)
         self.started = time.monotonic()
+
+    def _on_estop(self, msg) -> None:
+        if msg.data != self.estop:  # the flag is republished every few seconds; only changes count
+            self.estop = msg.data
+            self._estop_log.append((self.name, msg.data, time.time()))
 
     def _angle(self) -> float:
         return self.phase + SPEED_MPS / RADIUS_M * (time.monotonic() - self.started)
@@ -103,7 +119,11 @@ def main() -> None:
     context = Context()
     rclpy.init(context=context, signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node("bench_fleet_load", context=context)
-    robots = [Robot(node, i, name) for i, name in enumerate(names)]
+    estop_log: list = []
+    robots = [Robot(node, i, name, estop_log) for i, name in enumerate(names)]
+    executor = SingleThreadedExecutor(context=context)  # only the e-stop subscriptions; publishing stays here
+    executor.add_node(node)
+    threading.Thread(target=executor.spin, daemon=True).start()
     deadline = time.monotonic() + 30
     while any(r.odom.get_subscription_count() == 0 for r in robots) and time.monotonic() < deadline:
         time.sleep(0.05)
@@ -140,7 +160,9 @@ def main() -> None:
     print(json.dumps({"sent": sent, "seconds": round(elapsed, 2),
                       "rates": {k: round(v / elapsed / max(1, len(robots)), 2) for k, v in sent.items()},
                       "late_p99_ms": round(1000 * late[int(0.99 * (len(late) - 1))], 2) if late else None,
-                      "late_max_ms": round(1000 * late[-1], 2) if late else None}), flush=True)
+                      "late_max_ms": round(1000 * late[-1], 2) if late else None,
+                      "estop": estop_log}), flush=True)
+    executor.shutdown(timeout_sec=1)
     node.destroy_node()
     context.try_shutdown()
 
