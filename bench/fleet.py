@@ -16,7 +16,8 @@ odometry's age on arrival (its wall-clock stamp, set just before the publish, to
 receive timestamp of the frame in the viewer's socket; p50, p99, and the worst robot's p99);
 the e-stop/all HTTP round trip, the time until every viewer of every robot had its robot's
 `estop` event, and until the last robot's /<name>/e_stop said true in ROS (in the load
-generator's process); GET /api/robots; every robot's link state; the load generator's lag.
+generator's process); for comparison, one robot's own e-stop (POST /robots/<name>/api/estop);
+GET /api/robots; every robot's link state; the load generator's lag.
 
 ODOM_MAX_HZ: by default the app's own (10 Hz) applies, so the 50 Hz odometry reaches a viewer at
 ~10 Hz and a frame is the newest message when the interval is up: its age includes up to one
@@ -91,8 +92,9 @@ def estop_rounds(server: Server, fleet: SseFleet, robots: list[str], rounds: int
                 first[src] = t_arrived
 
         thread, out = in_thread(engage)
-        fleet.poll(1.5, on_event, source=True)
-        thread.join(10)
+        while thread.is_alive():  # the viewers keep reading while the request runs, however long
+            fleet.poll(0.25, on_event, source=True)
+        fleet.poll(1.0, on_event, source=True)
         if "error" in out:
             errors.append(out["error"])
             continue
@@ -113,8 +115,28 @@ def estop_rounds(server: Server, fleet: SseFleet, robots: list[str], rounds: int
         fleet.poll(0.5, lambda *a: None)
         if "error" in out:
             errors.append(out["error"])
+
+    # For comparison: one robot's own e-stop (the last robot's), engaged and released, as often.
+    last = f"{server.url}/robots/{robots[-1]}/api/estop"
+    single_ms = []
+    for _ in range(rounds):
+        def one():
+            t0 = time.monotonic()
+            session.post(last, json={"engaged": True}, timeout=10).raise_for_status()
+            took = time.monotonic() - t0
+            session.post(last, json={"engaged": False}, timeout=10).raise_for_status()
+            return took
+
+        thread, out = in_thread(one)
+        while thread.is_alive():
+            fleet.poll(0.25, lambda *a: None)
+        if "error" in out:
+            errors.append(out["error"])
+        else:
+            single_ms.append(1000 * out["value"])
+        fleet.poll(0.25, lambda *a: None)
     return {"http_ms": http_ms, "all_viewers_ms": all_viewers_ms, "missing": missing, "errors": errors,
-            "sent_wall": sent_wall}
+            "sent_wall": sent_wall, "single_http_ms": single_ms}
 
 
 def estop_in_ros(sent_wall: list[float], log: list, robots: list[str]) -> tuple[list[float], int]:
@@ -243,6 +265,7 @@ def describe(r: dict) -> str:
             f"{r['worst_robot_p99_ms']:.1f}, n={r['odom_events']})  estop/all HTTP p50/max "
             f"{ms_pair(e['http_ms'])} ms, at every viewer {ms_pair(e['all_viewers_ms'])} ms, missed {e['missing']}, "
             f"every robot's /e_stop true in ROS {ms_pair(e.get('ros_ms', []))} ms, missed {e.get('ros_missing')}, "
+            f"one robot's own e-stop HTTP {ms_pair(e['single_http_ms'])} ms, "
             f"errors {e['errors'] or 0}  /api/robots p50 {statistics.median(r['robots_api_ms']):.1f} ms  "
             f"links {r['links']}  silent viewers {r['silent_viewers']}  callback errors {r['callback_errors']}  "
             f"discovery {r['discovery_s']:.1f} s  machine load average {r['loadavg'][0]:.1f}->{r['loadavg'][-1]:.1f}"
@@ -252,7 +275,7 @@ def describe(r: dict) -> str:
 def table(results: list[dict]) -> str:
     head = ("| robots | viewers | CPU idle | CPU load only | CPU load + viewers | RSS | threads | odom / viewer | "
             "odom age p50 / p99 (worst robot) | e-stop/all HTTP p50 / max | at every viewer p50 / max | "
-            "last robot's /e_stop p50 / max | "
+            "last robot's /e_stop p50 / max | one robot's e-stop HTTP p50 / max | "
             "/api/robots p50 | load average |")
     rows = [head, "|" + " --- |" * (head.count("|") - 1)]
     for r in results:
@@ -262,7 +285,8 @@ def table(results: list[dict]) -> str:
             f"{r['rss']:.0f} MB | {r['threads']} | {r['odom_hz'][0]:.1f}-{r['odom_hz'][1]:.1f} Hz | "
             f"{r['odom_ms'][0]:.1f} / {r['odom_ms'][1]:.1f} ({r['worst_robot_p99_ms']:.1f}) ms | "
             f"{ms_pair(e['http_ms'])} ms | {ms_pair(e['all_viewers_ms'])} ms | {ms_pair(e.get('ros_ms', []))} ms | "
-            f"{statistics.median(r['robots_api_ms']):.1f} ms | {r['loadavg'][0]:.1f}-{r['loadavg'][-1]:.1f} |")
+            f"{ms_pair(e['single_http_ms'])} ms | {statistics.median(r['robots_api_ms']):.1f} ms | "
+            f"{r['loadavg'][0]:.1f}-{r['loadavg'][-1]:.1f} |")
     return "\n".join(rows)
 
 
