@@ -90,6 +90,7 @@ class Server:
 # when the kernel queued those bytes on the socket (CLOCK_REALTIME), however late the reader wakes.
 SO_TIMESTAMPNS = getattr(socket, "SO_TIMESTAMPNS", 35)
 _REALTIME_MINUS_MONOTONIC = time.time() - time.monotonic()
+WALL_MINUS_MONOTONIC = _REALTIME_MINUS_MONOTONIC  # arrival + this = wall clock, for wall-clock stamps
 
 
 def stamp_arrivals(sock: socket.socket) -> None:
@@ -112,20 +113,31 @@ class SseFleet:
     While polling, the fleet only receives; frames are parsed when the poll ends, so this one
     Python process standing in for N browsers takes as little CPU from the server as it can."""
 
-    def __init__(self, url: str, path: str, n: int):
+    def __init__(self, url: str, path: str | list[str], n: int = 1):
+        """n connections to `path`, or n to each path of a list (bench/fleet.py: one per robot)."""
         host, port = url.removeprefix("http://").split(":")
         self.sel = selectors.DefaultSelector()
         self.buffers: dict[socket.socket, bytes] = {}
-        for _ in range(n):
-            s = socket.create_connection((host, int(port)))
-            stamp_arrivals(s)
-            s.sendall(f"GET {path} HTTP/1.1\r\nHost: {host}:{port}\r\nAccept: text/event-stream\r\n\r\n".encode())
-            s.setblocking(False)
-            self.sel.register(s, selectors.EVENT_READ)
-            self.buffers[s] = b""
+        self.paths: dict[socket.socket, str] = {}
+        self.bytes_received = 0
+        for one in [path] if isinstance(path, str) else path:
+            for _ in range(n):
+                s = socket.create_connection((host, int(port)))
+                stamp_arrivals(s)
+                s.sendall(f"GET {one} HTTP/1.1\r\nHost: {host}:{port}\r\nAccept: text/event-stream\r\n\r\n".encode())
+                s.setblocking(False)
+                self.sel.register(s, selectors.EVENT_READ)
+                self.buffers[s] = b""
+                self.paths[s] = one
 
-    def poll(self, seconds: float, on_event) -> None:
-        """For `seconds`, receive; then call on_event(woken, arrived, event_name, data_dict) per frame."""
+    @property
+    def open_count(self) -> int:
+        """Connections the server has not closed."""
+        return len(self.sel.get_map())
+
+    def poll(self, seconds: float, on_event, source: bool = False) -> None:
+        """For `seconds`, receive; then call on_event(woken, arrived, event_name, data_dict) per frame,
+        with a fifth argument, the connection's (path, socket number), if `source`."""
         end = time.monotonic() + seconds
         chunks: list[tuple[socket.socket, float, float, bytes]] = []
         while (remaining := end - time.monotonic()) > 0:
@@ -141,6 +153,7 @@ class SseFleet:
                     self.sel.unregister(s)
                     continue
                 chunks.append((s, t, t_arrived, data))
+                self.bytes_received += len(data)
         for s, t_woken, t_arrived, data in chunks:
             buf = self.buffers[s] + data
             # Chunked transfer framing lines are skipped; SSE frames end with a blank line.
@@ -153,7 +166,10 @@ class SseFleet:
                     elif line.startswith(b"data: "):
                         payload = line[6:]
                 if name and payload is not None:
-                    on_event(t_woken, t_arrived, name, json.loads(payload))
+                    if source:
+                        on_event(t_woken, t_arrived, name, json.loads(payload), (self.paths[s], s.fileno()))
+                    else:
+                        on_event(t_woken, t_arrived, name, json.loads(payload))
             self.buffers[s] = buf
 
     def close(self) -> None:
@@ -163,6 +179,18 @@ class SseFleet:
             except (KeyError, ValueError):
                 pass
             s.close()
+
+
+def start_peer(script: str, env: dict, *args: str) -> subprocess.Popen:
+    """A bench/ script in its own process, returned once it prints "publishing" (its peers found)."""
+    proc = subprocess.Popen([sys.executable, str(ROOT / "bench" / script), *args], cwd=ROOT, env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    line = proc.stdout.readline()
+    if "publishing" not in line:
+        proc.kill()
+        proc.wait(5)
+        raise RuntimeError(f"{script} did not start: {line!r}")
+    return proc
 
 
 def percentile(values: list[float], p: float) -> float:

@@ -17,18 +17,9 @@ import threading
 import time
 
 import requests
-from common import ROOT, Server, SseFleet, machine, ros_env
+from common import ROOT, Server, SseFleet, machine, ros_env, start_peer
 
 ODOM = "/bench/odom"
-
-
-def start(script: str, env: dict, *args: str) -> subprocess.Popen:
-    proc = subprocess.Popen([sys.executable, str(ROOT / "bench" / script), *args], cwd=ROOT, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-    line = proc.stdout.readline()
-    if "publishing" not in line:
-        raise RuntimeError(f"{script} did not start: {line!r}")
-    return proc
 
 
 def received(server: Server) -> int:
@@ -75,7 +66,7 @@ def main() -> None:
         show("idle", measure(server, fleet, args.seconds))
 
         n = int(1000 * (args.seconds + 4))
-        logs = start("rosout_publisher.py", env, "--rate", "1000", "--count", str(n))
+        logs = start_peer("rosout_publisher.py", env, "--rate", "1000", "--count", str(n))
         procs.append(logs)
         time.sleep(1.0)
         show("1,000 log lines/s", measure(server, fleet, args.seconds))
@@ -106,7 +97,7 @@ def main() -> None:
         threading.Thread(target=keep_alive, daemon=True).start()
         time.sleep(1.0)
         show("100 Hz field plotted", measure(server, fleet, args.seconds))
-        logs = start("rosout_publisher.py", env, "--rate", "1000", "--count", str(n))
+        logs = start_peer("rosout_publisher.py", env, "--rate", "1000", "--count", str(n))
         procs.append(logs)
         time.sleep(1.0)
         show("both", measure(server, fleet, args.seconds))
@@ -118,7 +109,7 @@ def main() -> None:
 
         rss0 = server.rss_mb()
         before = received(server)
-        flood = start("rosout_publisher.py", env, "--rate", "0", "--count", str(args.flood))
+        flood = start_peer("rosout_publisher.py", env, "--rate", "0", "--count", str(args.flood))
         procs.append(flood)
         took = flood.stdout.readline().strip()
         flood.wait(120)
