@@ -175,9 +175,12 @@ class RosRuntime:
         """The node clock's current time as builtin_interfaces/Time, for stamping headers."""
         return self.node.get_clock().now().to_msg()
 
-    def topic_stats(self, stale_after_s: float) -> list[dict]:
+    def topic_stats(self, stale_after_s: float, under: str = "") -> list[dict]:
+        """Every tracked topic, or those under the namespace `under` (one robot's, of several)."""
         now = time.monotonic()
-        return [s.snapshot(stale_after_s, now) for s in sorted(self._stats.values(), key=lambda s: s.topic)]
+        prefix = under.rstrip("/") + "/"
+        return [s.snapshot(stale_after_s, now) for s in sorted(self._stats.values(), key=lambda s: s.topic)
+                if s.topic.startswith(prefix)]
 
     @staticmethod
     def _qos(qos: str | int):

@@ -26,7 +26,9 @@ def link_state(topics: list[dict], link_topics: list[str]) -> str:
 
 def build_status(rover: Rover) -> dict:
     runtime, config = rover.runtime, rover.config
-    topics = runtime.topic_stats(config["ROVER_WEB_STALE_AFTER_S"])
+    # A robot's own topics only: with 20 robots, every status event listing every robot's topics
+    # was 24 kB a second to each viewer (BENCHMARKS.md, several robots).
+    topics = runtime.topic_stats(config["ROVER_WEB_STALE_AFTER_S"], under=rover.robot.namespace)
     return {
         "node": runtime.node_name,
         "middleware": runtime.middleware,

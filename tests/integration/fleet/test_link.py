@@ -82,6 +82,9 @@ def test_the_drone_s_silence_loses_only_its_link_and_stops_only_its_drive(fleet_
         assert get(server.robot[name] + "/api/status")["link_topics"] == [ODOM[name]]
     beat = heartbeat()
     wait_until(lambda: link(server, "boat") == link(server, "drone") == "ok", timeout=15, what="both links ok")
+    for name in NAMES:  # each robot's status lists its own topics, not the whole fleet's
+        listed = [t["topic"] for t in get(server.robot[name] + "/api/status")["topics"]]
+        assert ODOM[name] in listed and all(t.startswith(f"/{name}/") for t in listed), listed
     # /api/robots reads the status channel, refreshed every ROVER_WEB_STATUS_PERIOD_S.
     wait_until(lambda: fleet_links(server) == {"boat": "ok", "drone": "ok"}, timeout=2, what="/api/robots: both ok")
     assert wait_until(lambda: fleet_speeds(server) == SPEED, what="each robot's own speed shown")
