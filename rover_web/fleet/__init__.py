@@ -84,6 +84,7 @@ def build_fleet(settings: dict[str, Any], runtime, db_path: Path, db_claim) -> F
 
 def init_app(app: Flask, fleet: Fleet) -> None:
     app.register_blueprint(routes.bp)
+    app.context_processor(routes.layout_context)
     app.wsgi_app = RobotPrefix(app.wsgi_app, fleet.names)
     if len(fleet) > 1:
         fleet.graph.add_nav("Robots", "/robots")
