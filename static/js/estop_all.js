@@ -8,7 +8,7 @@ import { sendEstopOverSocket } from './teleop_link.js';
 
 const RETRY_MS = 250;
 const ATTEMPTS = 40;
-const NOTE_MS = 6000;
+const NOTE_MS = 4000;
 const box = document.getElementById('estop-all');
 const button = document.getElementById('estop-all-engage');
 const note = document.getElementById('estop-all-note');
@@ -17,7 +17,7 @@ let noteTimer = null;
 
 function show(state, text) {
   box.dataset.state = state;
-  button.textContent = { sending: 'STOPPING…', done: 'ALL STOPPED', failed: 'STOP ALL FAILED' }[state] || 'STOP ALL';
+  button.textContent = { sending: 'STOPPING…', done: 'ALL STOPPED', failed: 'NOT STOPPED' }[state] || 'STOP ALL';
   clearTimeout(noteTimer);
   note.textContent = text;
   note.hidden = !text;

@@ -129,7 +129,10 @@ function frame(robots) {
   framed = placed.length;
   const bounds = new maplibregl.LngLatBounds();
   for (const r of placed) bounds.extend([r.position.lng, r.position.lat]);
-  map.fitBounds(bounds, { padding: 80, maxZoom: 17, duration: 0 });
+  // More room on the right: each marker's name is drawn there. Less of it all on a small map.
+  const side = Math.min(60, container.clientWidth / 8, container.clientHeight / 8);
+  const padding = { top: side, bottom: side, left: side, right: Math.min(180, container.clientWidth / 3) };
+  map.fitBounds(bounds, { padding, maxZoom: 17, duration: 0 });
 }
 
 // --- polling ---

@@ -106,19 +106,26 @@ def test_selector_keeps_the_page_and_its_query(fleet, page):
     assert shown_robot(page) == ("boat", "boat")
 
 
-def test_stop_all_engages_every_robot_and_the_bar_keeps_its_height(fleet, page):
+@pytest.mark.parametrize("width", [1280, 375])  # a desktop's one line; a phone's fixed rows
+def test_stop_all_engages_every_robot_and_the_bar_keeps_its_height(fleet, page, width):
     server, _ = fleet
+    page.set_viewport_size({"width": width, "height": 800})
     open_live(page, robot_url(server, "drone"))
     before = topbar_rows(page)
-    assert before["rows"] == 1
+    if width > 700:
+        assert before["rows"] == 1
+    posted = []
+    page.on("request", lambda r: r.method == "POST" and posted.append(r.url))
     page.locator("#estop-all-engage").click()
     page.wait_for_selector("#estop-all[data-state='done']", timeout=10000)
-    assert "boat" in page.locator("#estop-all-note").inner_text()
+    assert page.locator("#estop-all-note").inner_text() == "e-stop engaged: boat, drone"
+    assert posted == [server.url + "/api/estop/all"]  # the app's, not under the page's robot
     for name in ("boat", "drone"):
         assert requests.get(robot_url(server, name, "/api/estop"), timeout=5).json()["engaged"] is True
     page.wait_for_selector("#estop[data-engaged='yes']", timeout=5000)  # the page's own robot, over its SSE
     assert page.locator("#estop-release").is_visible()
     assert topbar_rows(page) == before  # the engaged e-stop, Release and the note changed nothing
+    assert page.evaluate("document.documentElement.scrollWidth") <= width  # and nothing left the screen
     assert page.watch.console_errors == []
 
 
