@@ -224,3 +224,48 @@ def test_one_robot_shows_no_selector_and_no_stop_all(live_server, page):
     assert page.locator("#estop-all").count() == 0
     assert page.locator("#estop-engage").is_visible()
     assert topbar_rows(page)["rows"] == 1
+
+
+def test_a_viewer_may_stop_all(live_server_factory, page, tmp_path):
+    """Engaging is anyone's: a signed-in viewer's Stop all stops every robot."""
+    from tests.browser.test_auth import sign_in
+    from tests.support.auth import add_users
+
+    db_path = tmp_path / "signed.sqlite3"
+    tokens = add_users(db_path)
+    server = live_server_factory(ROVER_WEB_ROBOTS=ROBOTS, ROVER_WEB_AUTH="required", ROVER_WEB_DB_PATH=str(db_path))
+    sign_in(page, server.url, "viewer")
+    open_live(page, robot_url(server, "drone"), drive=False)
+    assert shown_robot(page) == ("drone", "drone")
+    assert page.locator("body").get_attribute("data-can-operate") == "no"
+    page.locator("#estop-all-engage").click()
+    page.wait_for_selector("#estop-all[data-state='done']", timeout=10000)
+    for name in ("boat", "drone"):
+        latch = requests.get(robot_url(server, name, "/api/estop"), timeout=5,
+                             headers={"Authorization": f"Bearer {tokens['viewer']}"}).json()
+        assert latch["engaged"] is True and latch["by"] == "viewer"
+    assert page.watch.console_errors == []
+
+
+def test_fleet_pages_keep_the_content_security_policy(live_server_factory, browser):
+    """As tests/browser/test_csp.py, for what several robots add: the selector, Stop all, the fleet map."""
+    from tests.conftest import PageWatch
+
+    server = live_server_factory(ROVER_WEB_ROBOTS=ROBOTS)
+    context = browser.new_context(viewport={"width": 1280, "height": 900})  # bypass_csp stays off
+    try:
+        page = context.new_page()
+        watch = PageWatch(page)
+        page.goto(server.url + "/robots")
+        page.wait_for_selector("#fleet-map[data-ready='yes']", timeout=10000)
+        with page.expect_navigation():
+            page.select_option("#robot-select", label="drone")  # robot_select.js ran under the policy
+        assert page.url == robot_url(server, "drone", "/robots")
+        page.goto(robot_url(server, "drone"))
+        page.wait_for_selector("#link-server[data-state='live']", timeout=10000)
+        page.locator("#estop-all-engage").click()
+        page.wait_for_selector("#estop-all[data-state='done']", timeout=10000)
+        assert watch.console_errors == [], watch.console_errors
+        assert watch.offhost == []
+    finally:
+        context.close()
