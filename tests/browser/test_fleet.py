@@ -269,3 +269,30 @@ def test_fleet_pages_keep_the_content_security_policy(live_server_factory, brows
         assert watch.offhost == []
     finally:
         context.close()
+
+
+def test_driving_keys_on_the_selector_never_switch_the_robot(fleet, page):
+    """A closed <select> picks by key ("d" jumps to the drone, arrows step): on the selector those
+    keys only leave it, and from the next press the keyboard drives the robot shown."""
+    server, peer = fleet
+    open_live(page, robot_url(server, "boat"))
+    page.focus("#robot-select")
+    page.keyboard.press("d")
+    page.focus("#robot-select")
+    page.keyboard.press("ArrowDown")
+    page.wait_for_timeout(300)  # a navigation would have begun by now
+    assert page.url == robot_url(server, "boat")
+    assert shown_robot(page) == ("boat", "boat")
+    assert page.evaluate("document.activeElement.id") != "robot-select"
+    page.keyboard.down("w")
+    peer.wait_for("/boat/cmd_vel", lambda m: m["linear"]["x"] > 0, timeout=5.0)
+    page.keyboard.up("w")
+    peer.wait_for("/boat/cmd_vel", is_zero, timeout=2.0)
+    assert all(lin == 0 and ang == 0 for _, lin, ang in twists(peer, "/drone/cmd_vel"))
+    # Opening the list (Alt+Down) still lets a keyboard choose.
+    page.focus("#robot-select")
+    page.keyboard.press("Alt+ArrowDown")
+    with page.expect_navigation():
+        page.keyboard.press("ArrowDown")
+        page.keyboard.press("Enter")
+    assert page.url == robot_url(server, "drone")
