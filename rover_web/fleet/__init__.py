@@ -7,6 +7,10 @@
   POST /api/estop/all       every robot's e-stop (rover_web.estop)
 
 build_fleet makes one Rover per robot (core/fleet.py); each feature's init_app sets up every robot.
+Pages: with several robots every page's top bar has a robot selector (the same page for another
+robot, templates/partials/robot_select.html) and "Stop all" (partials/estop_all.html), from the
+`fleet_robots`, `current_robot` and `app_root` this package gives every template; the fleet page
+polls /api/robots (static/js/fleet.js says why not a stream per robot).
 Modules: prefix (the WSGI mount), summary (a robot's line on
 the fleet page), routes; the setting and naming rules are rover_web/core/robots.py.
 """
@@ -84,6 +88,7 @@ def build_fleet(settings: dict[str, Any], runtime, db_path: Path, db_claim) -> F
 
 def init_app(app: Flask, fleet: Fleet) -> None:
     app.register_blueprint(routes.bp)
+    app.context_processor(routes.layout_context)
     app.wsgi_app = RobotPrefix(app.wsgi_app, fleet.names)
     if len(fleet) > 1:
         fleet.graph.add_nav("Robots", "/robots")

@@ -1,10 +1,11 @@
-"""GET /api/robots and the /robots fleet page."""
+"""GET /api/robots, the /robots fleet page, and what every page's top bar needs to switch robots."""
 
 from __future__ import annotations
 
 from flask import Blueprint, jsonify, render_template, request
 
 from rover_web.core.state import current_rover
+from rover_web.waypoints.service import WaypointsService
 
 from .prefix import app_root
 from .summary import summary
@@ -26,4 +27,13 @@ def robots():
 
 @bp.get("/robots")
 def fleet_page():
-    return render_template("robots.html", robots=_robots())
+    return render_template("robots.html", robots=_robots(),
+                           map_config=current_rover().feature(WaypointsService).map_config())
+
+
+def layout_context() -> dict:
+    """The robot selector and "Stop all" in base.html: which robots, which one this page drives,
+    and the app root the robots' URLs start from (the page's own root is the robot's prefix)."""
+    rover = current_rover()
+    robots = [r.robot for r in rover.fleet] if rover.fleet is not None else [rover.robot]
+    return {"fleet_robots": robots, "current_robot": rover.robot, "app_root": app_root(request.environ)}

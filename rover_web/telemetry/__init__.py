@@ -38,4 +38,4 @@ def _init_robot(rover: Rover) -> None:
     rover.runtime.subscribe(msgs.BATTERY_STATE, rover.config["ROVER_WEB_BATTERY_TOPIC"],
                             lambda msg: rover.hub.publish_throttled("battery", msgs.battery_summary(msg),
                                                                     BATTERY_MAX_HZ), qos="sensor_data")
-    rover.add_panel(10, "panels/odom.html", "Robot", channels=("odom",))
+    rover.add_panel(10, "panels/odom.html", "Robot", channels=("odom", "battery"))

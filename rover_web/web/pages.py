@@ -18,6 +18,7 @@ def dashboard():
     for panel in rover.dashboard_panels:
         channels += [c for c in panel.channels if c not in channels]
     return render_template("dashboard.html", status=build_status(rover), odom=rover.hub.latest("odom"),
+                           battery=rover.hub.latest("battery"),
                            panels=rover.dashboard_panels, channels=channels)
 
 

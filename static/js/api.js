@@ -9,8 +9,13 @@
 // '' otherwise. Every path a page asks for is under it, so a page drives the robot it shows.
 export const base = (typeof document !== 'undefined' && document.body && document.body.dataset.base) || '';
 
-// A root-relative path ('/api/teleop') under the page's robot.
-export const at = (path) => (path.startsWith('/') ? base + path : path);
+// Where the app itself is mounted, before any robot's prefix: routes for every robot at once
+// (POST /api/estop/all) and the robots' own URLs start here. '' when served at the host's root.
+export const appRoot = (typeof document !== 'undefined' && document.body && document.body.dataset.appRoot) || '';
+
+// A root-relative path ('/api/teleop') under the page's robot, or with { root: true } under the
+// app's root whichever robot the page shows.
+export const at = (path, { root = false } = {}) => (path.startsWith('/') ? (root ? appRoot : base) + path : path);
 
 export class ApiError extends Error {
   constructor(status, code, message, reply = null) {
@@ -41,14 +46,14 @@ export async function errorFrom(response) {
 
 // body: an object to send as JSON, or a string that already is JSON text (an uploaded file),
 // sent as it is so the server, not the page, judges it. null, like undefined, sends no body:
-// fetch refuses any body on a GET.
-export async function api(method, url, body) {
+// fetch refuses any body on a GET. options.root: the path is the app's, not the page robot's (at()).
+export async function api(method, url, body, options = {}) {
   const init = { method, headers: { Accept: 'application/json' } };
   if (body !== undefined && body !== null) {
     init.headers['Content-Type'] = 'application/json';
     init.body = typeof body === 'string' ? body : JSON.stringify(body);
   }
-  const response = await fetch(at(url), init);
+  const response = await fetch(at(url, options), init);
   if (!response.ok) throw await errorFrom(response);
   const reply = await readJSON(response);
   if (reply === undefined) {

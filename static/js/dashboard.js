@@ -23,3 +23,10 @@ on('odom', (o) => {
   text('odom-angular', o.angular.toFixed(2));
   text('odom-position', `${o.x.toFixed(2)}, ${o.y.toFixed(2)}`);
 });
+
+on('battery', (b) => {
+  text('odom-battery-percent', b.percent === null ? '—' : b.percent.toFixed(0));
+  text('odom-battery-voltage', b.voltage === null ? '—' : b.voltage.toFixed(2));
+  const el = document.getElementById('odom-battery');
+  if (el) el.title = `${el.dataset.topic}: ${b.status}`;
+});

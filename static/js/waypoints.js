@@ -5,60 +5,12 @@
 import { api } from './api.js';
 import { on } from './live.js';
 import { attachGeofence } from './geofence_map.js';
+import { createGpsMap, fmtLatLng } from './gps_map.js';
 
 const el = document.getElementById('wp-map');
 if (el) init(el);
 
 function $(id) { return document.getElementById(id); }
-
-function fmtLatLng(lat, lng) {
-  const ns = lat >= 0 ? 'N' : 'S';
-  const ew = lng >= 0 ? 'E' : 'W';
-  return `${Math.abs(lat).toFixed(7)}° ${ns}, ${Math.abs(lng).toFixed(7)}° ${ew}`;
-}
-
-// --- the map's own style: nothing is fetched unless a local basemap is installed ---
-
-function buildStyle(cfg) {
-  const style = {
-    version: 8,
-    sources: {
-      graticule: { type: 'geojson', data: { type: 'FeatureCollection', features: [] } },
-      track: { type: 'geojson', data: { type: 'FeatureCollection', features: [] } },
-    },
-    layers: [{ id: 'background', type: 'background', paint: { 'background-color': '#17212b' } }],
-  };
-  if (cfg.basemap) {
-    const { name, ...source } = cfg.basemap;
-    style.sources.basemap = { type: 'raster', ...source };
-    style.layers.push({ id: 'basemap', type: 'raster', source: 'basemap' });
-  }
-  style.layers.push(
-    { id: 'graticule', type: 'line', source: 'graticule',
-      paint: { 'line-color': cfg.basemap ? '#00000033' : '#5b6b7b', 'line-width': 1 } },
-    { id: 'track', type: 'line', source: 'track',
-      layout: { 'line-cap': 'round', 'line-join': 'round' },
-      paint: { 'line-color': '#58a6ff', 'line-width': 3, 'line-opacity': 0.85 } },
-  );
-  return style;
-}
-
-const GRID_STEPS = [30, 10, 5, 2, 1, 0.5, 0.2, 0.1, 0.05, 0.02, 0.01, 0.005, 0.002, 0.001,
-  0.0005, 0.0002, 0.0001, 0.00005, 0.00002, 0.00001];
-
-function graticule(bounds) {
-  const west = Math.max(-180, bounds.getWest());
-  const east = Math.min(180, bounds.getEast());
-  const south = Math.max(-85, bounds.getSouth());
-  const north = Math.min(85, bounds.getNorth());
-  const span = Math.max(east - west, north - south);
-  const step = GRID_STEPS.find((s) => span / s >= 4) || GRID_STEPS[GRID_STEPS.length - 1];
-  const features = [];
-  const line = (coordinates) => features.push({ type: 'Feature', properties: {}, geometry: { type: 'LineString', coordinates } });
-  for (let x = Math.ceil(west / step) * step; x <= east && features.length < 200; x += step) line([[x, south], [x, north]]);
-  for (let y = Math.ceil(south / step) * step; y <= north && features.length < 400; y += step) line([[west, y], [east, y]]);
-  return { type: 'FeatureCollection', features };
-}
 
 function init(container) {
   const cfg = JSON.parse(container.dataset.config);
@@ -252,9 +204,15 @@ function init(container) {
   // --- the map ---
 
   try {
-    map = new maplibregl.Map({
-      container, style: buildStyle(cfg), center: cfg.center, zoom: cfg.zoom,
-      attributionControl: { compact: true }, dragRotate: false, pitchWithRotate: false,
+    map = createGpsMap(container, cfg, {
+      sources: { track: { type: 'geojson', data: { type: 'FeatureCollection', features: [] } } },
+      layers: [{ id: 'track', type: 'line', source: 'track',
+        layout: { 'line-cap': 'round', 'line-join': 'round' },
+        paint: { 'line-color': '#58a6ff', 'line-width': 3, 'line-opacity': 0.85 } }],
+      onLoad: () => {
+        loaded = true;
+        if (pendingTrack) map.getSource('track').setData(pendingTrack);
+      },
     });
   } catch (err) {
     const note = $('wp-map-note');
@@ -265,22 +223,6 @@ function init(container) {
   let geofence = { handleClick: () => false };
   if (map) {
     geofence = attachGeofence(map);
-    map.touchZoomRotate.disableRotation();
-    map.addControl(new maplibregl.NavigationControl({ showCompass: false }));
-    map.addControl(new maplibregl.ScaleControl({ unit: 'metric' }));
-    map.on('error', (e) => {
-      // A tile the local store does not have is normal at its edges; anything else is a bug.
-      if (e.sourceId === 'basemap' && e.error && e.error.status === 404) return;
-      console.error('map error', e.error || e);
-    });
-    const updateGrid = () => map.getSource('graticule').setData(graticule(map.getBounds()));
-    map.on('load', () => {
-      loaded = true;
-      container.dataset.ready = 'yes';
-      updateGrid();
-      if (pendingTrack) map.getSource('track').setData(pendingTrack);
-    });
-    map.on('moveend', () => { if (loaded) updateGrid(); });
     map.on('click', (e) => {
       const target = e.originalEvent && e.originalEvent.target;
       if (target && target.closest && target.closest('.maplibregl-marker, .maplibregl-popup')) return;
