@@ -32,7 +32,8 @@ def check_access():
         return None
     if not current_user.is_authenticated:
         if request.method == "GET" and not wants_json(request):
-            return redirect(url_for("auth.login_form", next=request.full_path.rstrip("?")))
+            # With the script root: sign-in at /robots/drone/login returns to the drone's page.
+            return redirect(url_for("auth.login_form", next=request.script_root + request.full_path.rstrip("?")))
         response = error_response(401, "unauthenticated",
                                   "sign in at /login, or send the header Authorization: Bearer <token>")
         response.headers["WWW-Authenticate"] = 'Bearer realm="rover_web"'
@@ -57,7 +58,7 @@ def _safe_next(target: str | None) -> str:
     # Only a path on this server: never an open redirect to another site.
     if target and target.startswith("/") and not target.startswith("//") and "\\" not in target:
         return target
-    return "/"
+    return request.script_root + "/"
 
 
 # --- sign-in ---

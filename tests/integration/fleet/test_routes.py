@@ -148,3 +148,23 @@ def test_sign_in_and_roles_hold_under_every_robot_s_prefix(app_factory, tmp_path
     assert client.post("/robots/drone/api/estop", json=release, headers=as_("viewer")).status_code == 403
     assert client.post("/robots/drone/api/estop", json=release, headers=as_("operator")).json["engaged"] is False
     assert client.get("/robots/boat/api/estop", headers=as_("viewer")).json["engaged"] is True
+
+
+def test_signing_in_from_a_robot_s_page_comes_back_to_that_robot(app_factory, tmp_path):
+    from tests.support.auth import PASSWORD, add_users
+
+    db = tmp_path / "signed.sqlite3"
+    add_users(db, "operator")
+    client = app_factory(ROVER_WEB_ROBOTS=ROBOTS, ROVER_WEB_AUTH="required", ROVER_WEB_DB_PATH=str(db)).test_client()
+    page = client.get("/robots/drone/livemap")
+    assert page.status_code == 302
+    assert page.headers["Location"] == "/robots/drone/login?next=/robots/drone/livemap"
+    form = client.get(page.headers["Location"])
+    assert b'value="/robots/drone/livemap"' in form.data
+    signed = client.post("/robots/drone/login", data={"username": "operator", "password": PASSWORD,
+                                                      "next": "/robots/drone/livemap"})
+    assert signed.status_code == 303 and signed.headers["Location"] == "/robots/drone/livemap"
+    # No next: back to the robot's own dashboard, not the first robot's.
+    client.post("/robots/drone/logout")
+    signed = client.post("/robots/drone/login", data={"username": "operator", "password": PASSWORD})
+    assert signed.headers["Location"] == "/robots/drone/"
