@@ -94,7 +94,8 @@ class LiveServer:
         return self.app.extensions["rover_web"]
 
     def stop(self) -> None:
-        self.rover.hub.close()  # end open event streams so their threads finish
+        for robot in self.rover.fleet:  # end every robot's open event streams so their threads finish
+            robot.hub.close()
         self.server.shutdown()
         self.server.server_close()
 
