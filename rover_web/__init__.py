@@ -75,9 +75,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         topics,
         waypoints,
     )
-    from rover_web import (
-        fleet as fleet_pages,
-    )
+    from rover_web import fleet as fleet_pages
     from rover_web.core.state import EXTENSION
     from rover_web.fleet import build_fleet
     from rover_web.ros.runtime import RosRuntime

@@ -24,7 +24,6 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 
-
 class FleetHub:
     """The graph scope's hub: a graph-wide channel (topics, rosout, plot) is on every robot's
     stream, so a page of any robot sees it. Publishing costs one append per robot."""

@@ -110,10 +110,9 @@ NAME_LISTS = ("ROVER_WEB_LINK_TOPICS", "ROVER_WEB_ESTOP_CANCEL_ACTIONS")
 
 
 def settings_for(robot: Robot, settings: dict[str, Any], *, first: bool) -> dict[str, Any]:
-    """The settings one robot's features read: names resolved, and a database of its own.
+    """The settings one robot's features read: every ROS name resolved under its namespace.
 
-    The first robot keeps ROVER_WEB_DB_PATH, so a one-robot install that grows keeps its records
-    (users live there too); robot `boat` gets `<stem>-boat<suffix>` beside it.
+    The first robot without a namespace reads the settings as they are (one robot, as before).
     """
     from rover_web.config import PREFIX, SETTINGS
 

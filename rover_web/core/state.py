@@ -179,7 +179,7 @@ def current_rover() -> Rover:
     if rover.fleet is None or not has_request_context():
         return rover
     name = request.environ.get(ROBOT_ENVIRON)
-    return rover.fleet.get(name) or rover if name else rover
+    return (rover.fleet.get(name) or rover) if name else rover
 
 
 def current_feature(cls: type[T]) -> T:
