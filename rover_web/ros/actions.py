@@ -15,40 +15,23 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 
-import rclpy
 from action_msgs.srv import CancelGoal
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
-from rclpy.parameter import Parameter
+
+from .side_node import SideNode
 
 RETURN_CODES = {0: "canceled", 1: "rejected", 2: "no_goals", 3: "no_goals"}  # 2, 3: nothing to cancel
 
 
 class GoalCanceller:
     def __init__(self, runtime, actions: list[str], namespace: str = ""):
-        context = runtime.context
         # In the robot's namespace: each robot's canceller is a node of its own name (/boat/rover_web_estop).
-        self._node = rclpy.create_node(
-            f"{runtime.node.get_name()}_estop", namespace=namespace or runtime.node.get_namespace(), context=context,
-            start_parameter_services=False,
-            parameter_overrides=[Parameter("start_type_description_service", value=False)])
+        self._side = SideNode(runtime, "estop", namespace=namespace)
+        self._node = self._side.node
         self._clients = {name: self._node.create_client(CancelGoal, f"{name.rstrip('/')}/_action/cancel_goal")
                          for name in actions}
-        self._executor = SingleThreadedExecutor(context=context)
-        self._executor.add_node(self._node)
-        self._thread = threading.Thread(target=self._spin, name="estop-cancel-executor", daemon=True)
-        self._thread.start()
-        runtime.on_stop(self.close)
-
-    def _spin(self) -> None:
-        try:
-            self._executor.spin()
-        except ExternalShutdownException:
-            pass
 
     def close(self) -> None:
-        self._executor.shutdown(timeout_sec=1.0)
-        self._thread.join(1.0)
-        self._node.destroy_node()
+        self._side.close()
 
     @property
     def actions(self) -> list[str]:
@@ -101,7 +84,7 @@ class GoalCanceller:
             return
         for name, future in pending:
             future.add_done_callback(lambda f, name=name: answered(name, f))
-        self._executor.wake()
+        self._side.wake()
         timer = threading.Timer(timeout_s, finish)
         timer.daemon = True
         timer.start()

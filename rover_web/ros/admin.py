@@ -1,6 +1,6 @@
 """Other nodes' parameters, services and actions, called from request threads.
 
-Everything here lives on a small node of its own (`<app node>_admin`) with its own executor
+Everything here lives on a small node of its own (`<app node>_admin`, a SideNode) with its own executor
 thread, like the e-stop's GoalCanceller: the clients made for these calls never sit in the main
 executor's wait set, so teleop and the event paths do not pay for them. A request thread sends
 a call and waits on its future with a timeout; it never spins.
@@ -16,16 +16,14 @@ from collections import OrderedDict
 from collections.abc import Callable
 from typing import Any
 
-import rclpy
 from rcl_interfaces.msg import Parameter as ParameterMsg
 from rcl_interfaces.msg import ParameterType, ParameterValue
 from rcl_interfaces.srv import DescribeParameters, GetParameters, ListParameters, SetParameters
 from rclpy.action import ActionClient
 from rclpy.action.graph import get_action_client_names_and_types_by_node, get_action_server_names_and_types_by_node
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
-from rclpy.parameter import Parameter
 
 from .convert import message_to_dict
+from .side_node import SideNode
 
 MAX_CLIENTS = 64  # service and action clients kept for reuse; the oldest is destroyed past this
 
@@ -78,29 +76,13 @@ def _range(descriptor) -> dict | None:
 
 class AdminNode:
     def __init__(self, runtime):
-        context = runtime.context
-        self._node = rclpy.create_node(
-            f"{runtime.node.get_name()}_admin", namespace=runtime.node.get_namespace(), context=context,
-            start_parameter_services=False,
-            parameter_overrides=[Parameter("start_type_description_service", value=False)])
-        self._executor = SingleThreadedExecutor(context=context)
-        self._executor.add_node(self._node)
+        self._side = SideNode(runtime, "admin")
+        self._node = self._side.node
         self._clients: OrderedDict[tuple, Any] = OrderedDict()
         self._lock = threading.Lock()
-        self._thread = threading.Thread(target=self._spin, name="ros-admin-executor", daemon=True)
-        self._thread.start()
-        runtime.on_stop(self.close)
-
-    def _spin(self) -> None:
-        try:
-            self._executor.spin()
-        except ExternalShutdownException:
-            pass
 
     def close(self) -> None:
-        self._executor.shutdown(timeout_sec=1.0)
-        self._thread.join(1.0)
-        self._node.destroy_node()
+        self._side.close()
 
     @property
     def own_names(self) -> set[str]:
@@ -168,13 +150,13 @@ class AdminNode:
                     old.destroy()
                 else:
                     self._node.destroy_client(old)
-        self._executor.wake()
+        self._side.wake()
         return client
 
     def _wait(self, future, timeout_s: float, what: str):
         done = threading.Event()
         future.add_done_callback(lambda _f: done.set())
-        self._executor.wake()
+        self._side.wake()
         if not done.wait(timeout_s):
             raise NoAnswer(f"{what} did not answer within {timeout_s:g} s")
         return future.result()
@@ -252,7 +234,7 @@ class AdminNode:
                     late.cancel_goal_async()
 
             sending.add_done_callback(cancel_late)
-            self._executor.wake()
+            self._side.wake()
             raise
         if not handle.accepted:
             return None
@@ -267,13 +249,13 @@ class AdminNode:
                 on_result("unknown", {"error": str(exc)[:200]})
 
         handle.get_result_async().add_done_callback(finished)
-        self._executor.wake()
+        self._side.wake()
         return goal_id, handle
 
     def cancel_goal(self, handle, timeout_s: float | None) -> str | None:
         """Ask to cancel; with a timeout, wait for the answer ("canceling", "rejected", ...)."""
         future = handle.cancel_goal_async()
-        self._executor.wake()
+        self._side.wake()
         if timeout_s is None:
             return None
         response = self._wait(future, timeout_s, "the action server")
