@@ -52,6 +52,7 @@ def _init_robot(rover: Rover) -> None:
     estop = EStopService(
         EStopStore(rover.db),
         zero=rover.cmd_vel.zero,
+        hold=rover.cmd_vel.hold_zero, unhold=rover.cmd_vel.release_hold,
         publish_flag=lambda engaged: flag.publish(msgs.flag(engaged)),
         canceller=canceller,
         on_change=lambda state: rover.hub.publish(CHANNEL, state))

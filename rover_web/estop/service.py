@@ -44,9 +44,14 @@ class ReleaseRefused(Exception):
 class EStopService:
     def __init__(self, store: EStopStore, *, zero: Callable[[], None], publish_flag: Callable[[bool], None],
                  canceller=None,
-                 on_change: Callable[[dict], None], clock: Callable[[], float] = time.time):
+                 on_change: Callable[[dict], None], clock: Callable[[], float] = time.time,
+                 hold: Callable[[], None] | None = None, unhold: Callable[[], None] | None = None):
         self._store = store
         self._zero = zero
+        # The velocity output's hold (rover_web/ros/cmd_vel.py): from the engage's zero to the
+        # release, whatever else would publish goes out as zero, teleop not yet told included.
+        self._hold = hold or zero
+        self._unhold = unhold
         self._publish_flag = publish_flag
         self._canceller = canceller  # has cancel_all(on_done) and running() (rover_web.ros.actions)
         self._on_change = on_change
@@ -56,6 +61,7 @@ class EStopService:
         self.engaged_event = threading.Event()  # set while engaged: gates the zero-velocity loop
         if self._engaged:
             self.engaged_event.set()
+            self._hold()  # engaged since the last run
         self._state = {**loaded, "via": None, "persisted": True, "cancel": None}
         self._epoch = 0  # +1 per engage, so a release can tell that one came while it wrote
         self._lock = threading.Lock()  # guards the state in memory; never held across I/O
@@ -132,6 +138,8 @@ class EStopService:
                 else:
                     self._engaged = False
                     self.engaged_event.clear()
+                    if self._unhold is not None:  # under the lock: an engage from now on holds again
+                        self._unhold()
                     self._state = {**released, "via": None, "persisted": True, "cancel": None}
                     again = None
             if again is not None:
@@ -163,7 +171,7 @@ class EStopService:
         # while engaged, zero and the flag go out again, and nothing else: the hooks (a panel's
         # Stop, its log line on disk) already ran, and a held or repeated press must stay fast.
         try:
-            self._zero()
+            self._hold()
         except Exception:
             log.exception("e-stop: zero velocity could not be published")
         self._publish_flag_safely(True)

@@ -35,6 +35,7 @@ class CmdVelOutput:
         self._twist = self._msg.twist if stamped else self._msg
         self._lock = threading.Lock()
         self._halted = False
+        self._held = False  # the e-stop's hold: only zero goes out until release_hold()
         self.last = (0.0, 0.0)
 
     @property
@@ -42,11 +43,11 @@ class CmdVelOutput:
         return self._halted
 
     def send(self, linear_mps: float, angular_rps: float) -> tuple[float, float]:
-        """Publish one command (clamped); returns what was published. Only zero once halted."""
+        """Publish one command (clamped); returns what was published. Only zero once halted or held."""
         linear = clamp(linear_mps, self.max_linear_mps)
         angular = clamp(angular_rps, self.max_angular_rps)
         with self._lock:
-            if self._halted:
+            if self._halted or self._held:
                 linear = angular = 0.0
             self._publish(linear, angular)
         return linear, angular
@@ -54,6 +55,22 @@ class CmdVelOutput:
     def zero(self) -> None:
         with self._lock:
             self._publish(0.0, 0.0)
+
+    def hold_zero(self) -> None:
+        """The e-stop: zero now, and nothing but zero until release_hold().
+
+        The e-stop's zero goes out before its hooks tell teleop, and in between teleop's repeater
+        (or a joystick frame already past its checks) could still send the held command: a
+        motion after the stop. Held here, at the one place velocity leaves the process, it is
+        sent as zero instead (caught by tests/browser/test_gamepad.py under load).
+        """
+        with self._lock:
+            self._held = True
+            self._publish(0.0, 0.0)
+
+    def release_hold(self) -> None:
+        with self._lock:
+            self._held = False
 
     def halt(self) -> None:
         """Shutdown: a zero command goes out now, and nothing but zero after it."""

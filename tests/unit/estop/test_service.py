@@ -19,6 +19,12 @@ class Robot:
     def zero(self):
         self.events.append("zero")
 
+    def hold(self):
+        self.events.append("hold")
+
+    def unhold(self):
+        self.events.append("unhold")
+
     def flag(self, engaged):
         self.events.append(f"flag:{engaged}")
 
@@ -200,3 +206,19 @@ def test_goal_cancel_outcomes_join_the_state(db):
     canceller.asked[0]([{"action": "/navigate_to_pose", "result": "canceled", "goals": 1}])
     assert estop.state()["cancel"] == [{"action": "/navigate_to_pose", "result": "canceled", "goals": 1}]
     assert robot.changes[-1]["cancel"][0]["result"] == "canceled"
+
+
+def test_the_output_is_held_from_the_engage_to_the_release_and_at_start_while_engaged(db):
+    robot = Robot()
+    estop = EStopService(EStopStore(db), zero=robot.zero, publish_flag=robot.flag, on_change=robot.changes.append,
+                         hold=robot.hold, unhold=robot.unhold)
+    estop.engage("ada")
+    estop.hold()  # the 40 Hz loop only sends zero: it never re-holds behind a release
+    assert robot.events == ["hold", "flag:True", "zero"]
+    estop.release("ada")
+    assert robot.events[3:] == ["unhold", "flag:False"]
+    estop.engage("bob")
+    restarted = Robot()
+    EStopService(EStopStore(db), zero=restarted.zero, publish_flag=restarted.flag,
+                 on_change=restarted.changes.append, hold=restarted.hold, unhold=restarted.unhold)
+    assert restarted.events == ["hold"]  # engaged since the last run: held before anything drives

@@ -1,0 +1,56 @@
+"""The velocity output's own rules: clamped, finite, zero only while the e-stop holds it or after halt.
+
+The publisher is a recorder: what is checked here is what CmdVelOutput hands it, not ROS (the
+ROS side is tests/integration/estop and tests/integration/teleop)."""
+
+import pytest
+
+pytest.importorskip("geometry_msgs")
+
+from rover_web.ros.cmd_vel import CmdVelOutput  # noqa: E402
+
+
+class Recorder:
+    def __init__(self):
+        self.sent = []
+
+    def publish(self, msg):
+        self.sent.append((msg.linear.x, msg.angular.z))
+
+
+class Runtime:
+    def __init__(self):
+        self.publisher_made = Recorder()
+
+    def publisher(self, msg_type, topic, qos):
+        return self.publisher_made
+
+
+def output():
+    runtime = Runtime()
+    return CmdVelOutput(runtime, "/cmd_vel", max_linear_mps=1.0, max_angular_rps=2.0), runtime.publisher_made.sent
+
+
+def test_commands_are_clamped_and_a_non_finite_one_is_a_stop():
+    out, sent = output()
+    out.send(5.0, -7.0)
+    out.send(float("nan"), float("inf"))
+    assert sent == [(1.0, -2.0), (0.0, 0.0)]
+
+
+def test_while_the_estop_holds_every_command_goes_out_as_zero_until_it_is_released():
+    out, sent = output()
+    out.hold_zero()
+    assert out.send(0.8, 1.0) == (0.0, 0.0)  # teleop not yet told: still nothing moves
+    out.hold_zero()  # pressed again
+    out.release_hold()
+    out.send(0.5, 0.0)
+    assert sent == [(0.0, 0.0), (0.0, 0.0), (0.0, 0.0), (0.5, 0.0)]
+
+
+def test_after_halt_only_zero_ever_goes_out():
+    out, sent = output()
+    out.halt()
+    out.release_hold()  # a release after shutdown changes nothing
+    out.send(0.5, 0.5)
+    assert sent == [(0.0, 0.0), (0.0, 0.0)]
