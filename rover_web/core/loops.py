@@ -53,6 +53,11 @@ class Loop:
 
     def join(self, timeout_s: float | None = None) -> bool:
         """True once the thread has ended (call after setting the stop event)."""
+        if self._gate is not None and self._stopping.is_set():
+            # A gated loop asleep on its closed gate would see the stop only at its next gate
+            # check, a second away: every app's shutdown took a second. Opened now, it wakes,
+            # finds the stop set and ends without calling fn. Its gate is read by nothing else.
+            self._gate.set()
         if self._thread.ident is not None:
             self._thread.join(timeout_s)
         return not self._thread.is_alive()
@@ -65,5 +70,6 @@ class Loop:
 def every(period_s: float, fn: Callable[[], object], *, name: str, stopping: threading.Event,
           immediately: bool = False, only_while: threading.Event | None = None) -> Loop:
     """Start a loop that calls `fn` every `period_s` (first right away with `immediately`); with
-    `only_while`, only while that event is set (a 40 Hz job that is idle most of the day)."""
+    `only_while`, only while that event is set (a 40 Hz job that is idle most of the day). The
+    event is the loop's alone: the loop's join at shutdown sets it, to wake the loop."""
     return Loop(name, period_s, fn, stopping, immediately=immediately, only_while=only_while).start()

@@ -5,7 +5,7 @@ import time
 
 import pytest
 
-from rover_web.core.loops import every
+from rover_web.core.loops import GATE_CHECK_S, every
 
 
 def test_a_loop_runs_at_its_period_and_survives_an_exception():
@@ -45,3 +45,14 @@ def test_a_gated_loop_runs_only_while_its_gate_is_open():
 def test_a_period_must_be_positive():
     with pytest.raises(ValueError):
         every(0, lambda: None, name="bad", stopping=threading.Event())
+
+
+def test_a_loop_asleep_on_its_closed_gate_ends_when_joined_without_waiting_for_its_gate_check():
+    stopping, gate = threading.Event(), threading.Event()
+    calls = []
+    loop = every(0.01, lambda: calls.append(1), name="gated", stopping=stopping, only_while=gate)
+    time.sleep(0.05)  # asleep on the gate
+    stopping.set()
+    # Well inside GATE_CHECK_S (1 s): the join itself wakes it (every app's shutdown waited 1 s).
+    assert loop.join(GATE_CHECK_S / 4)
+    assert calls == []  # woken to end, not to work
