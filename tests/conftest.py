@@ -215,20 +215,26 @@ def server_process(tmp_path):
         server.stop()
 
 
-@pytest.fixture
-def ros_peer():
-    from tests.support.rospeer import RosPeer
+def closing_factory(factory):
+    """A fixture's body: make(...) builds with `factory`, and every one made is closed after the test."""
+    made = []
 
-    peers = []
-
-    def make(name: str = "test_peer"):
-        peer = RosPeer(name)
-        peers.append(peer)
-        return peer
+    def make(*args, **kwargs):
+        thing = factory(*args, **kwargs)
+        made.append(thing)
+        return thing
 
     yield make
-    for peer in peers:
-        peer.close()
+    for thing in made:
+        thing.close()
+
+
+@pytest.fixture
+def ros_peer():
+    """make(name): a real ROS node in another process (tests/support/rospeer.py)."""
+    from tests.support.rospeer import RosPeer
+
+    yield from closing_factory(lambda name="test_peer": RosPeer(name))
 
 
 @pytest.fixture
@@ -236,16 +242,7 @@ def action_server():
     """make(name): tests/support/peers/action_server.py serving the action `name` in its own process."""
     from tests.support.action_peer import ActionServerPeer
 
-    made = []
-
-    def make(name):
-        peer = ActionServerPeer(name)
-        made.append(peer)
-        return peer
-
-    yield make
-    for peer in made:
-        peer.close()
+    yield from closing_factory(ActionServerPeer)
 
 
 class SimProcess:

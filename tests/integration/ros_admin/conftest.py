@@ -1,6 +1,6 @@
 import pytest
 
-from tests.support.action_peer import ActionServerPeer, AdminPeer
+from tests.support.action_peer import AdminPeer
 from tests.support.waiting import wait_until
 
 PEER = "/peer_ns/param_peer"
@@ -15,17 +15,9 @@ def admin_peer():
 
 
 @pytest.fixture
-def action_peer():
-    made = []
-
-    def make(name: str = "/fibonacci"):
-        peer = ActionServerPeer(name)
-        made.append(peer)
-        return peer
-
-    yield make
-    for peer in made:
-        peer.close()
+def action_peer(action_server):
+    """The root conftest's action_server, serving /fibonacci unless told otherwise."""
+    return lambda name="/fibonacci": action_server(name)
 
 
 def wait_for_parameters(client, timeout: float = 15.0) -> dict:
