@@ -7,30 +7,41 @@ import sys
 import time
 
 import psutil
+import pytest
 import requests
 
 from tests.conftest import free_port
 from tests.support.rospeer import ROOT, subprocess_env
 
 
-def test_demo_serves_the_simulated_robot_and_one_ctrl_c_stops_everything(tmp_path):
+def links(port: int) -> dict[str, str]:
+    """Each robot's link as /api/robots says it; {} while the GUI is not up yet."""
+    try:
+        robots = requests.get(f"http://127.0.0.1:{port}/api/robots", timeout=1).json()["robots"]
+    except requests.RequestException:
+        return {}
+    return {r["name"]: r["link"] for r in robots}
+
+
+@pytest.mark.parametrize("robots", [None, "boat,rover2"], ids=["one robot", "two namespaced robots"])
+def test_demo_serves_the_simulated_robots_and_one_ctrl_c_stops_everything(tmp_path, robots):
     port = free_port()
     env = subprocess_env(ROVER_WEB_DB_PATH=str(tmp_path / "demo.sqlite3"))
+    extra = ["--robots", robots] if robots else []
+    names = robots.split(",") if robots else ["robot"]
     # A terminal's Ctrl-C goes to the whole foreground process group: do the same.
-    proc = subprocess.Popen([sys.executable, "-m", "rover_web.demo", "--port", str(port)], cwd=ROOT, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True)
+    proc = subprocess.Popen([sys.executable, "-m", "rover_web.demo", "--port", str(port), *extra], cwd=ROOT,
+                            env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            start_new_session=True)
     try:
         deadline = time.monotonic() + 30
-        link = None
+        seen = {}
         while time.monotonic() < deadline:
-            try:
-                link = requests.get(f"http://127.0.0.1:{port}/api/status", timeout=1).json()["robot_link"]
-                if link == "ok":
-                    break
-            except requests.RequestException:
-                pass
+            seen = links(port)
+            if seen == dict.fromkeys(names, "ok"):
+                break
             time.sleep(0.2)
-        assert link == "ok", "the GUI never heard the simulated robot"
+        assert seen == dict.fromkeys(names, "ok"), f"the GUI never heard every simulated robot: {seen}"
         children = psutil.Process(proc.pid).children(recursive=True)
         assert any("rover_web.sim" in " ".join(c.cmdline()) for c in children)
         os.killpg(proc.pid, signal.SIGINT)
