@@ -109,14 +109,14 @@ def parse(value: Any) -> list[Robot]:
 NAME_LISTS = ("ROVER_WEB_LINK_TOPICS", "ROVER_WEB_ESTOP_CANCEL_ACTIONS")
 
 
-def settings_for(robot: Robot, settings: dict[str, Any], *, first: bool) -> dict[str, Any]:
+def settings_for(robot: Robot, settings: dict[str, Any]) -> dict[str, Any]:
     """The settings one robot's features read: every ROS name resolved under its namespace.
 
-    The first robot without a namespace reads the settings as they are (one robot, as before).
+    A robot without a namespace (the one robot of old) reads the settings as they are.
     """
     from rover_web.config import PREFIX, SETTINGS
 
-    if not robot.namespace and first:
+    if not robot.namespace:
         return settings
     mine = dict(settings)
     for setting in SETTINGS:

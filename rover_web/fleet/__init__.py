@@ -51,7 +51,7 @@ def build_fleet(settings: dict[str, Any], runtime, db_path: Path, db_claim) -> F
     claims = []  # the ones made here; the caller releases db_claim if this fails
     try:
         for i, robot in enumerate(robots):
-            config = robots_setting.settings_for(robot, settings, first=i == 0)
+            config = robots_setting.settings_for(robot, settings)
             path = db_path if i == 0 else robot_database(db_path, robot.name)
             held = db_claim
             if i:

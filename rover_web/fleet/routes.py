@@ -35,5 +35,5 @@ def layout_context() -> dict:
     """The robot selector and "Stop all" in base.html: which robots, which one this page drives,
     and the app root the robots' URLs start from (the page's own root is the robot's prefix)."""
     rover = current_rover()
-    robots = [r.robot for r in rover.fleet] if rover.fleet is not None else [rover.robot]
-    return {"fleet_robots": robots, "current_robot": rover.robot, "app_root": app_root(request.environ)}
+    return {"fleet_robots": [r.robot for r in rover.fleet], "current_robot": rover.robot,
+            "app_root": app_root(request.environ)}
