@@ -10,12 +10,13 @@ WRITE_403 = "ros_admin_off, ros_admin_read_only, denied, not_allowed (ROVER_WEB_
 TYPE_NAME = {"type": "string", "examples": ["std_srvs/srv/SetBool"]}
 
 PATHS = {
-    "/ros": {"get": page("Nodes, parameters, services and actions", tag="pages")},
+    "/ros": {"get": page("Nodes, parameters, services and actions", tag="pages",
+                         errors={403: "ros_admin_off (the page says so)"})},
     "/api/nodes": {"get": op("The nodes in the graph, with their topics, services and actions", tag="ros",
-                             ok=obj(closed=False))},
+                             ok=obj(closed=False), errors={403: OFF})},
     "/api/nodes/{node}/parameters": {
         "get": op("A node's parameters: name, type, value, description, read_only, ranges", tag="ros",
-                  ok=obj(closed=False), errors={400: "bad_node_name", **NODE}),
+                  ok=obj(closed=False), errors={400: "bad_node_name", 403: OFF, **NODE}),
     },
     "/api/nodes/{node}/parameters/{name}": {
         "put": op("Set one parameter, checked against its descriptor first", tag="ros", role="admin",
@@ -25,10 +26,11 @@ PATHS = {
                           409: "read_only, refused_by_node, estop_engaged (a safety node)",
                           504: "no_answer"}),
     },
-    "/api/services": {"get": op("Every service with its types", tag="ros", ok=obj(closed=False))},
+    "/api/services": {"get": op("Every service with its types", tag="ros", ok=obj(closed=False), errors={403: OFF})},
     "/api/types/{package}/{kind}/{name}": {
         "get": op("The fields of a message, service or action type (for generated forms)", tag="ros",
-                  ok=obj(closed=False), errors={400: "bad_type_name", 404: "unknown_kind", 422: "unknown_type"}),
+                  ok=obj(closed=False),
+                  errors={400: "bad_type_name", 403: OFF, 404: "unknown_kind", 422: "unknown_type"}),
     },
     "/api/services/call": {
         "post": op("Call a service; the request is checked field by field against its type", tag="ros",
@@ -39,7 +41,8 @@ PATHS = {
                            403: WRITE_403, 404: "unknown_service", 409: "estop_engaged", 422: "unknown_type",
                            504: "no_answer"}),
     },
-    "/api/actions/goals": {"get": op("Goals sent from here, running and recent", tag="ros", ok=obj(closed=False))},
+    "/api/actions/goals": {"get": op("Goals sent from here, running and recent", tag="ros", ok=obj(closed=False),
+                                     errors={403: OFF})},
     "/api/actions/goal": {
         "post": op("Send an action goal", tag="ros", role="admin", ok=obj(closed=False),
                    body=obj({"action": {"type": "string"}, "type": {"type": "string"}, "goal": obj(closed=False)},
@@ -53,17 +56,17 @@ PATHS = {
     "/api/actions/{goal_id}/cancel": {
         "post": op("Cancel a goal sent from here", tag="ros", role="operator", ok=obj(closed=False),
                    body=obj(closed=False), body_required=False,
-                   errors={400: "bad_json, bad_goal_id", 404: "unknown_goal", 504: "no_answer"}),
+                   errors={400: "bad_json, bad_goal_id", 403: OFF, 404: "unknown_goal", 504: "no_answer"}),
     },
     "/api/actions/{goal_id}/events": {
         "get": op("Server-Sent Events: a goal's status, feedback and result", tag="ros",
                   media="text/event-stream", ok={"type": "string"},
-                  errors={400: "bad_goal_id", 404: "unknown_goal", 503: "too_many_streams"},
+                  errors={400: "bad_goal_id", 403: OFF, 404: "unknown_goal", 503: "too_many_streams"},
                   extra={"x-stream": "sse"}),
     },
     "/api/ros/log": {
         "get": op("The operator log of parameter sets, service calls and goals", tag="ros", ok=obj(closed=False),
                   params=[query("limit", {"type": "integer", "minimum": 1, "maximum": 500}, "most entries")],
-                  errors={400: "bad_limit"}),
+                  errors={400: "bad_limit", 403: OFF}),
     },
 }
