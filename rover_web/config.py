@@ -204,6 +204,19 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("TOPICS_ECHO_MAX_SUBSCRIPTIONS", 16, "int",
             "most different topics (and types) echoed at once; viewers of the same one share it (503 beyond)",
             1, 1024),
+    # --- ROS admin (/ros: other nodes' parameters, services, action goals) ---
+    Setting("ROS_ADMIN", "on", "str",
+            "the /ros page and its API: on, read-only (look, never set, call or send) or off (403, no nav link)",
+            choices=("on", "read-only", "off")),
+    Setting("ROS_ADMIN_ALLOW", [], "list",
+            "if not empty, the only nodes, parameters, services and actions /ros may write to: [kind:]glob, "
+            "kind node, param, service or action (docs/ros_admin.md#allow-and-deny)"),
+    Setting("ROS_ADMIN_DENY", ["param:use_sim_time", "service:*/set_parameters*", "service:*/change_state",
+                               "service:*/load_parameters", "service:*/manage_nodes", "service:*/_action/*",
+                               "service:*/_container/*"], "list",
+            "[kind:]glob entries /ros never writes to, even for an admin; setting it replaces this default list"),
+    Setting("ROS_ADMIN_SAFETY_NODES", ["*"], "list",
+            "globs of node names whose parameters /ros never sets while the e-stop is engaged (409)"),
     # --- observability: /rosout, diagnostics, plots ---
     Setting("ROSOUT_KEEP", 5000, "int", "/rosout lines kept in memory (oldest dropped)", 10, 1000000),
     Setting("DIAGNOSTICS_STALE_S", 5.0, "float", "a diagnostic status older than this is stale",

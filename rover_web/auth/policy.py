@@ -5,8 +5,9 @@ Roles, each including the ones below it:
             sees danger must be able to stop the robot.
   operator  also everything that moves or commands the robot: driving (the teleop WebSocket and
             REST), taking over, releasing the e-stop, LiveMap goals, waypoint writes, the mission
-            send, panel unlock and commands, other nodes' parameters, service calls, action goals.
-  admin     also users and API tokens.
+            send, panel unlock and commands, canceling a goal sent from /ros.
+  admin     also users and API tokens, and /ros's writes: other nodes' parameters, service calls,
+            action goals (root over the ROS graph; docs/ros_admin.md#who-may-write).
 The default is closed: a state-changing route nobody listed needs the operator role.
 """
 
@@ -25,13 +26,14 @@ PUBLIC_ENDPOINTS = frozenset({"auth.login_form", "auth.login", "static"})
 # estop_set: the view checks release; estop_all only engages: whoever may watch may stop every robot.
 ANY_USER_ENDPOINTS = frozenset({"auth.logout", "estop.estop_set", "estop.estop_all"})
 ADMIN_ENDPOINT_PREFIX = "auth.admin_"
+ADMIN_ENDPOINTS = frozenset({"ros_admin.api_set_parameter", "ros_admin.api_call_service", "ros_admin.api_send_goal"})
 
 
 def required_role(method: str, path: str, endpoint: str | None) -> str | None:
     """The least role a request needs; None when it needs no sign-in at all."""
     if endpoint in PUBLIC_ENDPOINTS:
         return None
-    if endpoint and endpoint.startswith(ADMIN_ENDPOINT_PREFIX):
+    if endpoint and (endpoint.startswith(ADMIN_ENDPOINT_PREFIX) or endpoint in ADMIN_ENDPOINTS):
         return "admin"
     if path.startswith("/ws/"):
         return "operator"  # the teleop socket is how an operator drives

@@ -130,6 +130,20 @@ class AdminNode:
                 return list(types)
         return None
 
+    def serving_nodes(self, name: str, action: bool = False) -> list[str]:
+        """The nodes that serve the service (or action) `name`, by full name."""
+        node = self._node
+        out = []
+        for n, namespace in node.get_node_names_and_namespaces():
+            try:
+                served = (get_action_server_names_and_types_by_node(node, n, namespace) if action
+                          else node.get_service_names_and_types_by_node(n, namespace))
+            except Exception:  # the node left between the two queries
+                continue
+            if any(s == name for s, _ in served):
+                out.append(f"{namespace.rstrip('/')}/{n}")
+        return out
+
     # --- calls ---
 
     def _client(self, kind: str, cls: type, name: str):

@@ -8,27 +8,34 @@
   POST /api/actions/goal   GET /api/actions/goals   GET /api/actions/<goal_id>/events (SSE)
   POST /api/actions/<goal_id>/cancel                GET /api/ros/log (the operator log of all this)
 Calls go through rover_web.ros.admin on a node and executor of their own; goals sent from here are
-canceled when the e-stop engages. See docs/ros_admin.md.
+canceled when the e-stop engages. Writes need the admin role; ROVER_WEB_ROS_ADMIN (on, read-only,
+off), ROVER_WEB_ROS_ADMIN_ALLOW/_DENY and ROVER_WEB_ROS_ADMIN_SAFETY_NODES bound them. See docs/ros_admin.md.
 """
 
 from __future__ import annotations
 
 from flask import Flask
 
+from rover_web.config import ConfigError
 from rover_web.core.state import Rover
 from rover_web.estop import FleetEStop
 
 from . import routes
-from .service import RosAdmin
+from .service import RosAdmin, rules_from
 
 __all__ = ["init_app", "RosAdmin"]
 
 
 def init_app(app: Flask, rover: Rover) -> None:
     # Graph-wide: a call or goal names no robot, so any robot's e-stop refuses it and cancels it.
+    try:
+        rules_from(rover.config)  # a bad entry stops the app at start, naming the setting
+    except ValueError as exc:
+        raise ConfigError(str(exc)) from None
     estop = rover.feature(FleetEStop)
     admin = RosAdmin(rover, estop)
     rover.add_feature(admin)
     estop.on_engage(admin.on_estop)
     app.register_blueprint(routes.bp)
-    rover.add_nav("ROS", "/ros")
+    if admin.mode != "off":
+        rover.add_nav("ROS", "/ros")

@@ -7,7 +7,7 @@ import time
 
 from flask import Blueprint, Response, jsonify, render_template, request
 
-from rover_web.auth import signed_in_name
+from rover_web.auth import AuthService, may, signed_in_name
 from rover_web.core.state import current_feature, current_rover
 from rover_web.web.connection import peer_gone
 from rover_web.web.http import ApiError, error_response, json_body
@@ -17,6 +17,7 @@ from rover_web.web.validate import InvalidInput, number, only_keys, topic_name
 from .names import goal_id as valid_goal_id
 from .names import node_name
 from .parameters import PARAMETER_NAME
+from .secret_params import hide_parameters
 from .service import AdminRefused, RosAdmin
 
 bp = Blueprint("ros_admin", __name__)
@@ -33,6 +34,41 @@ def refused(exc: AdminRefused):
 @bp.errorhandler(InvalidInput)
 def invalid(exc: InvalidInput):
     return error_response(400, exc.code, str(exc))
+
+
+READ_METHODS = frozenset({"GET", "HEAD", "OPTIONS"})
+# Canceling a goal sent from here only stops it: allowed in read-only mode too, as the e-stop is.
+STOPS_ONLY = frozenset({"ros_admin.api_cancel_goal"})
+
+
+@bp.before_request
+def check_mode():
+    """ROVER_WEB_ROS_ADMIN: off refuses everything here, read-only every write."""
+    admin = current_feature(RosAdmin)
+    if admin.mode == "off":
+        if request.endpoint == "ros_admin.ros_page":
+            return render_template("ros.html", off=True, nodes=[], services=[], goals=[]), 403
+        raise ApiError(403, "ros_admin_off", "ROS admin is off on this server (ROVER_WEB_ROS_ADMIN=off): "
+                       "no node's parameters, services or actions are reached from here")
+    if admin.mode == "read-only" and request.method not in READ_METHODS and request.endpoint not in STOPS_ONLY:
+        raise ApiError(403, "ros_admin_read_only", "ROS admin is read-only on this server "
+                       "(ROVER_WEB_ROS_ADMIN=read-only): parameters, services and goals are shown, never sent")
+    return None
+
+
+def _is_admin() -> bool:
+    """Whether this request may write (the admin role; anyone with sign-in off, as for every route)."""
+    return may("admin", current_feature(AuthService).required)
+
+
+def _write_block() -> str | None:
+    """Why this page's user may not set, call or send, or None: for disabled buttons (the server decides)."""
+    admin = current_feature(RosAdmin)
+    if admin.mode == "read-only":
+        return "ROS admin is read-only on this server (ROVER_WEB_ROS_ADMIN=read-only)"
+    if not _is_admin():
+        return "setting parameters, calling services and sending goals needs the admin role"
+    return None
 
 
 def _client() -> str:
@@ -57,8 +93,13 @@ def _goal(text: str) -> str:
 @bp.get("/ros")
 def ros_page():
     admin = current_feature(RosAdmin)
-    return render_template("ros.html", nodes=admin.nodes(), services=admin.services(),
-                           goals=[g.snapshot() for g in admin.goals.all()])
+    nodes = admin.nodes()
+    services = [{**s, "refused": admin.service_refusal(s["name"])} for s in admin.services()]
+    actions = [{**a, "refused": admin.action_refusal(a["name"], a["types"][0] if a["types"] else "")}
+               for n in nodes for a in n["action_servers"]]
+    return render_template("ros.html", off=False, nodes=nodes, services=services, actions=actions,
+                           goals=[g.snapshot() for g in admin.goals.all()], write_block=_write_block(),
+                           can_cancel=may("operator", current_feature(AuthService).required))
 
 
 @bp.get("/api/nodes")
@@ -69,7 +110,13 @@ def api_nodes():
 @bp.get("/api/nodes/<path:node>/parameters")
 def api_parameters(node: str):
     name = _node(node)
-    return jsonify(node=name, parameters=current_feature(RosAdmin).parameters(name))
+    admin = current_feature(RosAdmin)
+    parameters = [{**p, "refused": admin.parameter_refusal(name, p["name"])} for p in admin.parameters(name)]
+    if not _is_admin():
+        parameters = hide_parameters(parameters)  # credentials live in parameters: values for admins only
+    else:
+        parameters = [{**p, "hidden": False} for p in parameters]
+    return jsonify(node=name, parameters=parameters, safety_node=admin.is_safety_node(name))
 
 
 @bp.put("/api/nodes/<path:node>/parameters/<path:name>")

@@ -2,7 +2,12 @@
 
 Every call goes through rover_web.ros.admin.AdminNode (its own node and executor thread) and waits
 with a timeout; every set, call, goal and cancel is written to the operator log with its
-arguments and outcome (the panels' log, under the name "ros").
+arguments and outcome (the panels' log, under the name "ros"), secrets left out.
+
+Before anything is sent: the allow and deny rules (access.py), the e-stop (service calls and goals
+always, parameter sets on ROVER_WEB_ROS_ADMIN_SAFETY_NODES), and no known navigation goal
+(navigation.py). Who may ask at all is the auth policy's (admin for writes) and the mode's
+(ROVER_WEB_ROS_ADMIN: on, read-only, off; routes.py).
 """
 
 from __future__ import annotations
@@ -17,8 +22,11 @@ from rover_web.ros.admin import AdminNode, NoAnswer
 from rover_web.ros.fields import FieldError, build, describe
 from rover_web.ros.typesupport import UnknownMessageType, interface_class, is_interface_package
 
+from .access import AccessRules, matches_any, parameter_subjects, parse_rules
 from .goals import Goal, GoalBook
+from .navigation import navigation_refusal
 from .parameters import ParameterRefused, check_value
+from .secret_params import HIDDEN, is_secret, scrub
 
 log = logging.getLogger(__name__)
 
@@ -27,6 +35,9 @@ LOG_KEEP = 500
 PARAMETER_TIMEOUT_S = 3.0
 GOAL_TIMEOUT_S = 5.0
 CANCEL_TIMEOUT_S = 3.0
+# Services whose answers are parameter values: their responses are not logged (secrets).
+VALUE_SERVICES = ("/get_parameters",)
+MODES = ("on", "read-only", "off")
 
 
 class AdminRefused(Exception):
@@ -47,11 +58,22 @@ def _type_class(type_name: str, kind: str) -> type:
         raise AdminRefused(422, "unknown_type", str(exc)) from None
 
 
+def rules_from(config: dict) -> AccessRules:
+    """The allow and deny rules of the settings; ValueError naming the setting for a bad entry."""
+    return AccessRules(parse_rules(config["ROVER_WEB_ROS_ADMIN_ALLOW"], "ROVER_WEB_ROS_ADMIN_ALLOW"),
+                       parse_rules(config["ROVER_WEB_ROS_ADMIN_DENY"], "ROVER_WEB_ROS_ADMIN_DENY"))
+
+
 class RosAdmin:
     def __init__(self, rover: Rover, estop, oplog: OperatorLog | None = None):
         self.rover = rover
         self.estop = estop
-        self.node = AdminNode(rover.runtime)
+        config = rover.config
+        self.mode = config["ROVER_WEB_ROS_ADMIN"]
+        self.rules = rules_from(config)
+        self.safety_nodes = tuple(config["ROVER_WEB_ROS_ADMIN_SAFETY_NODES"])
+        # Off: no node of its own at all, so nothing here can reach the graph.
+        self.node = AdminNode(rover.runtime) if self.mode != "off" else None
         self.oplog = oplog or OperatorLog(rover.db, LOG_KEEP)
         self.goals = GoalBook()
 
@@ -71,6 +93,28 @@ class RosAdmin:
         except EStopEngaged:
             self.record(control, label, args, "refused", "estop_engaged", client)
             raise
+
+    def _check_rules(self, subjects: list[tuple[str, str]]) -> None:
+        refused = self.rules.refusal(subjects)
+        if refused is not None:
+            raise AdminRefused(403, *refused)
+
+    def parameter_refusal(self, node: str, name: str) -> str | None:
+        """Why setting this parameter would be refused whatever the value (for the page), or None."""
+        refused = self.rules.refusal(parameter_subjects(node, name))
+        return refused[1] if refused else None
+
+    def service_refusal(self, service: str) -> str | None:
+        """Why calling this service would be refused by the rules on its name alone (for the page)."""
+        refused = self.rules.refusal([("service", service)])
+        return refused[1] if refused else None
+
+    def action_refusal(self, action: str, type_name: str) -> str | None:
+        refused = self.rules.refusal([("action", action)])
+        return refused[1] if refused else navigation_refusal(action, type_name)
+
+    def is_safety_node(self, node: str) -> bool:
+        return matches_any(self.safety_nodes, node)
 
     # --- nodes ---
 
@@ -93,7 +137,14 @@ class RosAdmin:
 
     def set_parameter(self, node: str, name: str, value: Any, client: str) -> dict:
         label = f"{node} {name}"
+        secret = is_secret(name)
+        logged = HIDDEN if secret else value
         try:
+            self._check_rules(parameter_subjects(node, name))
+            if self.is_safety_node(node) and self.estop.engaged:
+                raise AdminRefused(409, "estop_engaged", f"the e-stop is engaged and {node} is a safety node "
+                                   "(ROVER_WEB_ROS_ADMIN_SAFETY_NODES): its parameters stay as they are until "
+                                   "the e-stop is released")
             params = {p["name"]: p for p in self.parameters(node)}
             if name not in params:
                 raise AdminRefused(404, "unknown_parameter", f"{node} has no parameter {name}")
@@ -108,10 +159,11 @@ class RosAdmin:
             if not ok:
                 raise AdminRefused(409, "refused_by_node", f"{node} refused {name}: {reason or 'no reason given'}")
         except AdminRefused as exc:
-            self.record("set_parameter", label, value, "invalid" if exc.status == 400 else "refused",
-                        f"{exc.code}: {exc}", client)
+            # A refusal's message may quote the value ("got 0.3"): for a secret, only the code.
+            self.record("set_parameter", label, logged, "invalid" if exc.status == 400 else "refused",
+                        exc.code if secret else f"{exc.code}: {exc}", client)
             raise
-        self.record("set_parameter", label, value, "sent", "set", client)
+        self.record("set_parameter", label, logged, "sent", "set", client)
         return {"node": node, "name": name, "type": kind, "value": checked}
 
     # --- services ---
@@ -137,8 +189,9 @@ class RosAdmin:
     def call_service(self, service: str, type_name: str, request: Any, timeout_s: float, client: str) -> dict:
         from rover_web.ros.convert import message_to_dict
 
-        args = {"type": type_name, "request": request}
+        args = {"type": type_name, "request": scrub(request)}
         try:
+            self._check_rules([("service", service)])
             cls = _type_class(type_name, "srv")
             try:
                 message = build(cls.Request, request if request is not None else {}, "request")
@@ -150,6 +203,7 @@ class RosAdmin:
                 raise AdminRefused(404, "unknown_service", f"no service {service} in the ROS graph")
             if type_name not in known:
                 raise AdminRefused(400, "type_mismatch", f"{service} is a {', '.join(known)}, not {type_name}")
+            self._check_rules([("service", service)] + [("node", n) for n in self.node.serving_nodes(service)])
             try:
                 response = self.node.call(cls, service, message, timeout_s)
             except NoAnswer as exc:
@@ -159,20 +213,27 @@ class RosAdmin:
                         f"{exc.code}: {exc}", client)
             raise
         plain = message_to_dict(response, 256)
-        self.record("call_service", service, args, "sent", f"response: {str(plain)[:300]}", client)
+        shown = "(parameter values are not logged)" if service.endswith(VALUE_SERVICES) else str(scrub(plain))[:300]
+        self.record("call_service", service, args, "sent", f"response: {shown}", client)
         return plain
 
     # --- actions ---
 
     def send_goal(self, action: str, type_name: str, goal: Any, client: str) -> dict:
-        args = {"type": type_name, "goal": goal}
+        args = {"type": type_name, "goal": scrub(goal)}
         try:
+            self._check_rules([("action", action)])
+            refused = navigation_refusal(action, type_name)
+            if refused:
+                raise AdminRefused(403, "navigation_goal", refused)
             cls = _type_class(type_name, "action")
             try:
                 message = build(cls.Goal, goal if goal is not None else {}, "goal")
             except FieldError as exc:
                 raise AdminRefused(400, exc.code, str(exc)) from None
             self._check_estop("send_goal", action, args, client)
+            self._check_rules([("action", action)]
+                              + [("node", n) for n in self.node.serving_nodes(action, action=True)])
             tracked = Goal(None, action, type_name, None, client)
             try:
                 sent = self.node.send_goal(cls, action, message, GOAL_TIMEOUT_S, tracked.on_feedback,

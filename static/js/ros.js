@@ -1,7 +1,26 @@
 // The /ros page: each node's parameters as a form with the right input per type, service buttons
 // (std_srvs Trigger, SetBool, Empty) and forms generated from a type's fields, action goals with
-// their live feedback (one EventSource per running goal) and a cancel button.
+// their live feedback (one EventSource per running goal) and a cancel button. Buttons this user
+// may not use (a role below admin, read-only mode, a name the deny list refuses) are disabled with
+// the reason as their title; the server decides all the same.
 import { api, ApiError, at } from './api.js';
+
+const layout = document.querySelector('.ros-layout');
+const writeBlock = layout.dataset.writeBlock || '';
+const canCancel = layout.dataset.canCancel === 'yes';
+
+// The e-stop partial's state (body class set by estop.js); the server checks it again.
+const estopEngaged = () => document.body.classList.contains('estop-engaged');
+
+// Disabled, with why, when there is a reason; returns the button.
+function allowIf(button, reason) {
+  if (reason) {
+    button.disabled = true;
+    button.title = reason;
+    button.dataset.blocked = reason;
+  }
+  return button;
+}
 
 const BUTTON_TYPES = new Set(['std_srvs/srv/Trigger', 'std_srvs/srv/Empty', 'std_srvs/srv/SetBool']);
 const el = (tag, props = {}, ...children) => {
@@ -39,7 +58,11 @@ function parameterInput(p) {
     input = el('input', { type: 'text', value: JSON.stringify(p.value), title: `${p.type}, as JSON` });
   }
   input.name = p.name;
-  input.disabled = p.read_only;
+  input.disabled = p.read_only || p.hidden;
+  if (p.hidden) {
+    input.value = '';
+    input.placeholder = '(hidden: its name says it holds a secret)';
+  }
   return input;
 }
 
@@ -64,7 +87,10 @@ async function loadParameters(details) {
   const rows = reply.parameters.map((p) => {
     const input = parameterInput(p);
     const status = el('span', { className: 'ros-param-status small' });
-    const set = el('button', { type: 'button', textContent: 'set', disabled: p.read_only });
+    const set = allowIf(el('button', { type: 'button', textContent: 'set' }),
+      (p.read_only && 'read-only: set only when the node starts') || writeBlock || p.refused
+      || (p.hidden && 'hidden value') || (reply.safety_node && estopEngaged()
+        && 'a safety node: its parameters stay as they are while the e-stop is engaged') || '');
     set.addEventListener('click', async () => {
       let value;
       try { value = parameterValue(p, input); } catch (err) { say(status, `not JSON: ${err.message}`, false); return; }
@@ -149,16 +175,17 @@ async function callService(service, type, request) {
 for (const row of document.querySelectorAll('.ros-service')) {
   const { service, type } = row.dataset;
   const cell = row.querySelector('.ros-service-call');
+  const reason = writeBlock || row.dataset.refused;
   if (BUTTON_TYPES.has(type)) {
     const choices = type === 'std_srvs/srv/SetBool' ? [['true', { data: true }], ['false', { data: false }]]
       : [['call', {}]];
     for (const [text, request] of choices) {
-      const button = el('button', { type: 'button', textContent: text });
+      const button = allowIf(el('button', { type: 'button', textContent: text }), reason);
       button.addEventListener('click', () => callService(service, type, request));
       cell.append(button, ' ');
     }
   } else {
-    const open = el('button', { type: 'button', textContent: 'form…' });
+    const open = allowIf(el('button', { type: 'button', textContent: 'form…' }), reason);
     open.addEventListener('click', async () => {
       open.remove();
       try {
@@ -194,7 +221,8 @@ function watchGoal(li, goal) {
   const end = () => { if (!ended) { ended = true; live -= 1; } };
   const status = el('span', { className: 'ros-goal-status', textContent: goal.status || '' });
   const feedback = el('pre', { className: 'ros-goal-feedback' });
-  const cancel = el('button', { type: 'button', textContent: 'cancel' });
+  const cancel = allowIf(el('button', { type: 'button', textContent: 'cancel' }),
+    canCancel ? '' : 'canceling a goal needs the operator role');
   cancel.addEventListener('click', async () => {
     try { await api('POST', `/api/actions/${goal.goal_id}/cancel`, {}); } catch (err) { status.textContent = failure(err); }
   });
@@ -225,7 +253,7 @@ for (const li of goalsList.querySelectorAll('li[data-goal]')) {
 }
 
 for (const box of document.querySelectorAll('.ros-action')) {
-  const open = box.querySelector('.ros-goal-form');
+  const open = allowIf(box.querySelector('.ros-goal-form'), writeBlock || box.dataset.refused);
   open.addEventListener('click', async () => {
     open.remove();
     const result = el('span', { className: 'small' });

@@ -91,3 +91,59 @@ def test_a_running_goal_is_followed_after_a_reload_and_canceled_from_the_page(li
     expect(page.locator(f'#ros-goals li[data-goal="{sent.json()["goal_id"]}"] .ros-goal-status')).to_have_text(
         "canceled")
     assert page.watch.console_errors == [] and not page.watch.offhost
+
+
+def sign_in(page, base_url, name):
+    from tests.support.auth import PASSWORD
+
+    page.goto(base_url + "/login?next=/ros")
+    page.fill("input[name=username]", name)
+    page.fill("input[name=password]", PASSWORD)
+    page.click("button[type=submit]")
+    page.wait_for_url("**/ros", wait_until="commit")
+
+
+def admin_graph_ready(server):
+    headers = {"Authorization": f"Bearer {server.tokens['admin']}"}
+    nodes = {n["name"]: n for n in requests.get(server.url + "/api/nodes", headers=headers, timeout=5).json()["nodes"]}
+    peer = nodes.get(PEER)
+    return (peer and any(s["name"] == "/peer_ns/set_enabled" for s in peer["services"])
+            and any(a["name"] == "/fibonacci" for n in nodes.values() for a in n["action_servers"]))
+
+
+def test_an_operator_sees_why_the_write_buttons_are_disabled_and_an_admin_does_not(signed_server, peers, browser):
+    """Issue 27: writes are admin work. The page says so; the server refuses all the same (test_access.py)."""
+    wait_until(lambda: admin_graph_ready(signed_server), 20, "the peers in the app's graph")
+    for role in ("operator", "admin"):
+        context = browser.new_context()
+        page = context.new_page()
+        try:
+            sign_in(page, signed_server.url, role)
+            node = page.locator(f'.ros-node[data-node="{PEER}"]')
+            node.locator("summary").click()
+            node.locator(".ros-load-params").click()
+            count = node.locator('tr[data-param="count"] button')
+            expect(count).to_be_visible(timeout=WAIT_MS)
+            secret = node.locator('tr[data-param="ntrip_password"] input')
+            call = page.locator('.ros-service[data-service="/peer_ns/set_enabled"]').get_by_role("button", name="true")
+            goal = page.locator('.ros-action[data-action="/fibonacci"] .ros-goal-form')
+            sim_time = node.locator('tr[data-param="use_sim_time"] button')
+            if role == "operator":
+                expect(page.locator("#ros-write-block")).to_contain_text("needs the admin role")
+                for button in (count, call, goal):
+                    expect(button).to_be_disabled()
+                    expect(button).to_have_attribute("title", "setting parameters, calling services and sending "
+                                                              "goals needs the admin role")
+                expect(secret).to_have_value("")
+                expect(secret).to_have_attribute("placeholder", "(hidden: its name says it holds a secret)")
+            else:
+                expect(page.locator("#ros-write-block")).to_have_count(0)
+                for button in (count, call, goal):
+                    expect(button).to_be_enabled()
+                expect(secret).to_have_value("hunter2")
+                # Denied for everyone: disabled with the rule that denies it.
+                expect(sim_time).to_be_disabled()
+                expect(sim_time).to_have_attribute("title", "param use_sim_time matches 'param:use_sim_time' in "
+                                                            "ROVER_WEB_ROS_ADMIN_DENY: never written from here")
+        finally:
+            context.close()

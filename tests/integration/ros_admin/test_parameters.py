@@ -19,7 +19,8 @@ def test_parameters_are_listed_with_types_values_and_descriptors(client, admin_p
         "flag": ("bool", True), "count": ("integer", 3), "gain": ("double", 0.5), "label": ("string", "hello"),
         "ids": ("integer_array", [1, 2, 3]), "weights": ("double_array", [0.5, 1.5]),
         "names": ("string_array", ["a", "b"]), "flags": ("bool_array", [True, False]),
-        "serial": ("string", "SN-1"), "speed": ("double", 1.0), "level": ("integer", 4), "guarded": ("string", "ok")}
+        "serial": ("string", "SN-1"), "speed": ("double", 1.0), "level": ("integer", 4), "guarded": ("string", "ok"),
+        "ntrip_password": ("string", "hunter2")}
     assert params["flag"]["description"] == "a switch"
     assert params["serial"]["read_only"] is True and params["flag"]["read_only"] is False
     assert params["speed"]["range"] == {"kind": "double", "from": 0.0, "to": 2.0, "step": 0.0}

@@ -5,7 +5,7 @@
 Parameters: flag (bool), count (integer), gain (double), label (string), ids (integer array),
 weights (double array), names (string array), blob (byte array), flags (bool array), serial
 (read-only string), speed (double, 0.0 to 2.0), level (integer, 0 to 10 step 2), guarded (string
-that the node itself refuses to set to "forbidden").
+that the node itself refuses to set to "forbidden"), ntrip_password (a string whose name says secret).
 Services (in the node's namespace): set_enabled (SetBool), trigger (Trigger), reset (Empty),
 silent (Trigger that never answers).
 stdout: {"event": "ready"}, {"event": "called", "service", "request"}; stdin: "quit".
@@ -46,6 +46,7 @@ def main() -> None:
     node.declare_parameter("level", 4, ParameterDescriptor(
         integer_range=[IntegerRange(from_value=0, to_value=10, step=2)]))
     node.declare_parameter("guarded", "ok")
+    node.declare_parameter("ntrip_password", "hunter2")
 
     def check(params):
         for p in params:
