@@ -44,6 +44,7 @@ class Schedule:
         self._windows: list[Window] = []
         self._made_until = now
         self.started = {STALL: 0, OUTAGE: 0}  # windows whose start has passed (counted by prune)
+        self.history: deque[Window] = deque(maxlen=10_000)  # windows that have ended, for benches
         self.set_profile(profile, now)
 
     def set_profile(self, profile: Profile, now: float) -> None:
@@ -76,7 +77,9 @@ class Schedule:
         """Forget windows that have ended, counting them."""
         self._make_until(now)
         while self._windows and self._windows[0].end <= now:
-            self.started[heapq.heappop(self._windows).kind] += 1
+            window = heapq.heappop(self._windows)
+            self.started[window.kind] += 1
+            self.history.append(window)
 
     def down(self, t: float) -> tuple[float, str] | None:
         """If the link is down at t: when it comes up (through back-to-back windows) and why
@@ -96,6 +99,11 @@ class Schedule:
         self._make_until(now)
         starts = [w.start for w in self._windows if w.kind == OUTAGE and w.start > now]
         return min([*starts, self._next_outage])
+
+    def begun(self, now: float) -> list[Window]:
+        """Every window that has begun by now (ended ones from the history), in order of start."""
+        self.prune(now)
+        return sorted([*self.history, *(w for w in self._windows if w.start <= now)])
 
     def count(self, kind: str, now: float) -> int:
         return self.started[kind] + sum(1 for w in self._windows if w.kind == kind and w.start <= now)

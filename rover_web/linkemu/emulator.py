@@ -186,6 +186,10 @@ class LinkEmulator:
                 self.tcp.chunk_bytes = chunk_bytes(new)
         self._call(swap)
 
+    def windows(self) -> list[tuple[float, float, str]]:
+        """(start, end, "stall"|"outage") of every window begun so far, on time.monotonic()."""
+        return self._call(lambda: [(w.start, w.end, w.kind) for w in self.schedule.begun(time.monotonic())])
+
     def counters(self) -> dict:
         """Bytes in, passed and dropped, queue depth now and at its peak, per direction; stalls and
         outages begun; connections."""

@@ -115,6 +115,10 @@ class TcpRelay:
                                      self._pump(server_r, client_w, self.down, conn.down))
             finally:
                 self.connections.discard(conn)
+        except asyncio.CancelledError:
+            # stop(): end quietly. Python 3.11's start_server asks a finished handler task for its
+            # exception, which raises (and is logged) for a cancelled one.
+            return
         finally:
             self._tasks.discard(task)
 

@@ -158,6 +158,8 @@ def test_stalls_come_about_as_often_as_the_profile_says_and_outages_on_the_perio
     assert schedule.count(OUTAGE, 1200) == 20  # at 30, 90, ..., 1170 s
     assert down_time[OUTAGE] == pytest.approx(60, rel=0.05)
     assert Schedule(p, random.Random(11), 0.0).down(30.5) == (33.0, OUTAGE)
+    outages = [(w.start, w.end) for w in schedule.begun(1200) if w.kind == OUTAGE]
+    assert outages[:2] == [(30, 33), (90, 93)] and len(outages) == 20
 
 
 def test_the_same_seed_gives_the_same_stalls():
