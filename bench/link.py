@@ -260,10 +260,10 @@ def run(args) -> dict:
         events = Events(url)
         events.start()
         wait_for(lambda: events.ages, 60, "the first odom event through the link")
+        ws = connect(url)  # before the video: its handshake would otherwise queue behind seconds of frames
         if args.camera == "on":
             viewer = Viewer(url)
             wait_for(lambda: viewer.samples, 60, "the first camera frame through the link")
-        ws = connect(url)
         stick = Stick(ws)
         mark = sub.mark()
         stick.start()

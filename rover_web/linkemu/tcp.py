@@ -19,6 +19,20 @@ log = logging.getLogger(__name__)
 SOCKET_BUFFER = 32 * 1024
 
 
+# Ethernet-sized segments on loopback (whose MTU is 64 kB). A peer's TCP sizes its congestion
+# window, and from it its send buffer, in segments: with 64 kB segments a server streaming video
+# behind a 2 Mbit/s link grows its send buffer to 4 MB (16 s queued in the server's kernel); with
+# 1448-byte ones to about 1.3 MB (measured). A sender behind a real radio, whose window loss
+# keeps near the bottleneck's buffer, holds about half that: see docs/field.md.
+SEGMENT = 1448
+
+
+def _link_like(sock: socket.socket) -> None:
+    """Before connect or listen: the sizes a real link's peers would negotiate."""
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, SOCKET_BUFFER)
+    sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_MAXSEG, SEGMENT)
+
+
 def _small_buffers(sock: socket.socket) -> None:
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, SOCKET_BUFFER)
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, SOCKET_BUFFER)
@@ -69,7 +83,7 @@ class TcpRelay:
     async def start(self) -> tuple[str, int]:
         sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, SOCKET_BUFFER)  # inherited by accepted sockets
+        _link_like(sock)  # inherited by accepted sockets
         sock.bind(self.listen)
         # A small read-ahead limit: asyncio reads up to twice this before it stops reading the socket.
         self._server = await asyncio.start_server(self._accepted, sock=sock, limit=self.chunk_bytes)
@@ -98,6 +112,7 @@ class TcpRelay:
         try:
             _small_buffers(client_w.get_extra_info("socket"))
             sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+            _link_like(sock)
             _small_buffers(sock)
             sock.setblocking(False)
             try:

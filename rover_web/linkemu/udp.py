@@ -57,7 +57,14 @@ class _Client:
 
     async def connect(self) -> None:
         loop = asyncio.get_running_loop()
-        self.transport, _ = await loop.create_datagram_endpoint(lambda: _Back(self), remote_addr=self.relay.target)
+        try:
+            self.transport, _ = await loop.create_datagram_endpoint(lambda: _Back(self),
+                                                                    remote_addr=self.relay.target)
+        except OSError as exc:
+            log.info("udp relay: cannot reach %s:%d: %s", *self.relay.target, exc)
+            self._waiting.clear()
+            self.relay.clients.pop(self.addr, None)
+            return
         _roomy(self.transport)
         for data in self._waiting:
             self.transport.sendto(data)
