@@ -22,8 +22,9 @@ the emulator only; the rclpy subscriber watching /cmd_vel is on the robot's side
      clock at capture, rover_web/sim/timecode.py, read from the decoded JPEG): glass to glass.
    - event_age_p99_ms: odom SSE frames, kernel arrival time (wall) − the Odometry header stamp
      (the simulator's wall clock at publish).
-2. E-stop phase (`--estops` times, the stick released, camera and events still flowing): POST
-   /api/estop {"engaged": true} timed to its answer (estop_rtt_*), then a timed release.
+2. E-stop phase (`--estops` times, for at most 120 s; the stick released, camera and events still
+   flowing): POST /api/estop {"engaged": true} timed to its answer (estop_rtt_*), then a timed
+   release. A POST unanswered after 30 s counts as 30 s and is counted (estop_timeouts).
 link_rtt_ms is the profile's nominal round trip (2 × one-way delay); link_rtt_measured_ms is the
 median of 10 GET /api/estop on the idle link before the hold phase (a small request and answer).
 """
@@ -77,6 +78,7 @@ class Stick(threading.Thread):
         super().__init__(daemon=True)
         self.ws = ws
         self.sent: list[tuple[float, int]] = []  # (monotonic, value index)
+        self.lost_at: float | None = None  # when the socket failed under the stick, if it did
         self.running = threading.Event()
         self.running.set()
 
@@ -90,6 +92,7 @@ class Stick(threading.Thread):
             try:
                 self.ws.sock.sendall(data)
             except OSError:
+                self.lost_at = time.monotonic()  # the server closed it: reported, not retried
                 return
             self.sent.append((t, i % VALUES))
             i += 1
@@ -97,7 +100,11 @@ class Stick(threading.Thread):
     def release(self) -> None:
         self.running.clear()
         self.join(5)
-        self.ws.send(json.dumps({"stop": True}))
+        if self.lost_at is None:
+            try:
+                self.ws.send(json.dumps({"stop": True}))
+            except OSError:
+                self.lost_at = time.monotonic()
 
 
 def teleop_latencies(sent: list[tuple[float, int]], twists: list[tuple[float, float, float]]) -> list[float]:
@@ -204,20 +211,37 @@ def ms(values: list[float], p: float) -> float | None:
     return round(percentile(values, p), 1) if values else None
 
 
-def estop_trials(url: str, n: int) -> tuple[list[float], list[float]]:
-    """n × (engage, then release), each POST timed; a Session keeps its connection, as a page does."""
-    engage, release = [], []
+ESTOP_TIMEOUT_S = 30.0
+ESTOP_BUDGET_S = 120.0  # the phase stops starting trials after this long (a clogged link takes ~30 s each)
+
+
+def estop_trials(url: str, n: int) -> tuple[list[float], list[float], int]:
+    """n × (engage, then release), each POST timed; a Session keeps its connection, as a page does.
+    A POST unanswered after ESTOP_TIMEOUT_S counts as that long (and is counted): the p99 is then a
+    lower bound."""
+    engage, release, timeouts = [], [], 0
+    start = time.monotonic()
+
+    def timed(session, engaged: bool) -> float:
+        nonlocal timeouts
+        t0 = time.monotonic()
+        try:
+            session.post(url + "/api/estop", json={"engaged": engaged, "by": "bench"},
+                         timeout=ESTOP_TIMEOUT_S).raise_for_status()
+        except requests.Timeout:
+            timeouts += 1
+            return ESTOP_TIMEOUT_S * 1000
+        return (time.monotonic() - t0) * 1000
+
     with requests.Session() as session:
         for _ in range(n):
-            t0 = time.monotonic()
-            session.post(url + "/api/estop", json={"engaged": True, "by": "bench"}, timeout=30).raise_for_status()
-            engage.append((time.monotonic() - t0) * 1000)
+            if time.monotonic() - start > ESTOP_BUDGET_S:
+                break
+            engage.append(timed(session, True))
             time.sleep(0.3)
-            t0 = time.monotonic()
-            session.post(url + "/api/estop", json={"engaged": False, "by": "bench"}, timeout=30).raise_for_status()
-            release.append((time.monotonic() - t0) * 1000)
+            release.append(timed(session, False))
             time.sleep(0.7)
-    return engage, release
+    return engage, release, timeouts
 
 
 def link_rtt(url: str) -> float:
@@ -241,8 +265,16 @@ def adapt_setting(adapt: str | None) -> tuple[dict[str, str], str]:
     return {"ROVER_WEB_CAMERA_ADAPT": "true" if adapt == "on" else "false"}, adapt
 
 
+def bench_profile(name: str):
+    """A named profile, or `loopback`: no limits at all, what the machine alone costs (a control)."""
+    if name == "loopback":
+        return profile("custom", rate_kbps=1_000_000, delay_ms=0, buffer_kb=4096)
+    return profile(name)
+
+
 def run(args) -> dict:
-    link = profile(args.profile)
+    link = bench_profile(args.profile)
+    load_before = os.getloadavg()[0]
     scratch = tempfile.TemporaryDirectory(prefix="rover_web-bench-link-")
     extra, adapt = adapt_setting(args.adapt)
     env = ros_env(ROVER_WEB_DB_PATH=os.path.join(scratch.name, "bench.sqlite3"), **extra)
@@ -275,7 +307,7 @@ def run(args) -> dict:
         twists = sub.since(mark)
         said = dict(ws.heard.counts)
         t_estop = time.monotonic()
-        engage, release = estop_trials(url, args.estops)
+        engage, release, estop_timeouts = estop_trials(url, args.estops)
         t_estop_end = time.monotonic()
         windows = emu.windows()
         counters = emu.counters()
@@ -308,7 +340,7 @@ def run(args) -> dict:
     estop_frames = viewer.window(t_estop, t_estop_end) if viewer else []
     event_ages = [age for t, age in events.ages if t_start <= t <= t_end]
     result = {
-        "profile": link.name,
+        "profile": args.profile,
         "camera": args.camera,
         "video": args.video,
         "adapt": adapt,
@@ -321,6 +353,9 @@ def run(args) -> dict:
         "spurious_stops_per_min": round(stops_out / (held_s / 60), 2),
         "stops_in_outages": stops_in,
         "server_said": said,
+        "teleop_socket_lost_at_s": None if stick.lost_at is None else round(stick.lost_at - t_start, 1),
+        "estop_trials": len(engage),
+        "estop_timeouts": estop_timeouts,
         "estop_rtt_p50_ms": ms(engage, 50),
         "estop_rtt_p99_ms": ms(engage, 99),
         "estop_release_p99_ms": ms(release, 99),
@@ -337,6 +372,7 @@ def run(args) -> dict:
         "outages": counters["outages"],
         "down_queue_peak_kb": round(counters["down"]["queue_peak"] / 1000, 1),
         "seed": emu.seed,
+        "load_avg": [round(load_before, 1), round(os.getloadavg()[0], 1)],  # the machine's, start and end
     }
     return result
 
@@ -347,13 +383,17 @@ def table(r: dict) -> str:
     rows = [
         ("link", f"{r['profile']}: nominal RTT {r['link_rtt_ms']:g} ms, measured {r['link_rtt_measured_ms']} ms; "
                  f"{r['stalls']} stalls, {r['outages']} outages in the run; downlink queue peak "
-                 f"{r['down_queue_peak_kb']} kB"),
+                 f"{r['down_queue_peak_kb']} kB; load average {r['load_avg'][0]} → {r['load_avg'][1]}"),
         ("teleop frame → /cmd_vel", f"p50 {f(r['teleop_p50_ms'], ' ms')}, p99 {f(r['teleop_p99_ms'], ' ms')} "
                                     f"({r['teleop_frames_matched']} frames matched)"),
         ("spurious stops", f"{r['spurious_stops_per_min']} per minute held ({r['stops_in_outages']} more "
-                           f"during outages); server said {r['server_said'] or 'nothing'}"),
+                           f"during outages); server said {r['server_said'] or 'nothing'}"
+                           + ("" if r["teleop_socket_lost_at_s"] is None
+                              else f"; the teleop socket was lost {r['teleop_socket_lost_at_s']} s into the hold")),
         ("e-stop POST round trip", f"p50 {f(r['estop_rtt_p50_ms'], ' ms')}, p99 {f(r['estop_rtt_p99_ms'], ' ms')}; "
-                                   f"release p99 {f(r['estop_release_p99_ms'], ' ms')}"),
+                                   f"release p99 {f(r['estop_release_p99_ms'], ' ms')} ({r['estop_trials']} trials"
+                                   + (f", {r['estop_timeouts']} POSTs unanswered after {ESTOP_TIMEOUT_S:g} s"
+                                      if r["estop_timeouts"] else "") + ")"),
         ("video", f"{r['video_fps']} fps, {r['video_kbps']} kbit/s, frame age p50 {f(r['frame_age_p50_ms'], ' ms')}"
                   f", p99 {f(r['frame_age_p99_ms'], ' ms')} ({r['frames_unreadable']} unreadable)"),
         ("odom events", f"{r['events_per_s']} /s, age p50 {f(r['event_age_p50_ms'], ' ms')}, "
@@ -365,7 +405,8 @@ def table(r: dict) -> str:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--profile", choices=list(PROFILES), default="wifi-edge")
+    parser.add_argument("--profile", choices=[*PROFILES, "loopback"], default="wifi-edge",
+                        help="the link; loopback: the emulator with no limits, a control for the machine's own noise")
     parser.add_argument("--camera", choices=("on", "off"), default="on")
     parser.add_argument("--video", choices=("mjpeg", "webrtc"), default="mjpeg")
     parser.add_argument("--adapt", choices=("on", "off"), default=None,

@@ -154,5 +154,4 @@ class TcpRelay:
                     return
         except (ConnectionError, OSError):
             # A reset: the other side learns at once (a real link would carry the RST too).
-            for writer in (dest,):
-                writer.transport.abort()
+            dest.transport.abort()
