@@ -306,3 +306,18 @@ def test_the_flask_command_refuses_a_missing_target():
     done = subprocess.run([sys.executable, "-m", "flask", "--app", "rover_web", "link-emulator",
                            "--listen", "127.0.0.1:0"], env=env, capture_output=True, text=True, timeout=60)
     assert done.returncode == 2 and "--target" in done.stderr
+
+
+def test_a_stall_holds_every_byte_for_its_length(peer):
+    echo = peer(echo=True)
+    with LinkEmulator(profile("custom", delay_ms=5), "127.0.0.1:0", echo.address) as emu, \
+            socket.create_connection(("127.0.0.1", emu.port)) as client:
+        client.sendall(b"warm")
+        assert recv_exactly(client, 4) == b"warm"
+        emu.stall(800)
+        t0 = time.monotonic()
+        client.sendall(b"held")
+        client.settimeout(15)
+        assert recv_exactly(client, 4) == b"held"
+        assert time.monotonic() - t0 >= 0.7  # the stall began before the send: at least the rest of it
+        assert emu.counters()["stalls"] == 1
