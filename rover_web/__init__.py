@@ -45,12 +45,13 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     # The web layer first (every route's protection), then the CLI commands: those are registered
     # before, and without, the ROS node, so `flask tiles fetch` or `flask users add` never joins
     # the ROS graph.
-    from rover_web import auth, basemap
+    from rover_web import auth, basemap, linkemu
     from rover_web.web import http
 
     http.init_app(app)
     auth.init_cli(app)
     basemap.init_cli(app)
+    linkemu.init_cli(app)
     if process.is_reloader_watcher():
         log.warning("reloader watcher process: the ROS node starts in the serving child only")
         return app

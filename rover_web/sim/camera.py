@@ -2,7 +2,9 @@
 
 640×480 at 30 Hz by default. The pattern (colour bars over a grey ramp) is drawn once; each frame
 is a horizontal shift of it (a slice of a twice-as-wide copy) plus a small text box, so the node
-uses little CPU however long it runs.
+uses little CPU however long it runs. Each frame also carries its stamp (the wall clock, ms) as a
+machine-readable time code in the bottom-left corner (timecode.py), so a viewer can measure a
+frame's age glass to glass, through JPEG, a video codec and any link.
 """
 
 from __future__ import annotations
@@ -20,6 +22,8 @@ from sensor_msgs.msg import Image
 
 from rover_web.camera.imaging import font
 from rover_web.ros import qos as qos_profiles
+
+from . import timecode
 
 # SMPTE-like bars: white, yellow, cyan, green, magenta, red, blue, black.
 BARS = ((235, 235, 235), (235, 235, 16), (16, 235, 235), (16, 235, 16),
@@ -58,6 +62,7 @@ class PatternFrames:
         ImageDraw.Draw(label).text((6, 2), f"frame {n}  {clock}", fill=(255, 255, 255), font=self._font)
         w, h = self._box
         image[8:8 + h, 8:8 + w] = np.asarray(label)[: self.height - 8, : self.width - 8]
+        timecode.draw(image, round(stamp_s * 1000))
         return image
 
 

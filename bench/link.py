@@ -1,0 +1,429 @@
+"""rover_web over an emulated field link: teleop, e-stop, video and events through the link emulator.
+
+    .venv/bin/python bench/link.py --profile wifi-edge --camera on [--video mjpeg] [--adapt on|off]
+                                   [--seconds 60] [--estops 10] [--seed 1]
+
+Starts the demo's simulator (`python -m rover_web.sim`: rover, buoy, drone, camera 640×480 at
+30 Hz) and the app (`flask run`, bench/common.Server) in their own processes, and a LinkEmulator
+(rover_web/linkemu) in this one, in front of the app. Every client below talks to the app through
+the emulator only; the rclpy subscriber watching /cmd_vel is on the robot's side (DDS, no link).
+
+1. Hold phase, `--seconds`: a teleop WebSocket holds the stick at 25 Hz (a distinct value per
+   frame); with `--camera on` an MJPEG viewer reads /stream?topic=/camera/image_raw; an SSE client
+   reads /api/events?channels=odom.
+   - teleop_p50/p99_ms: the frame written to the socket → the first /cmd_vel Twist carrying its
+     value, seen by bench/cmd_vel_subscriber.py in its own process (CLOCK_MONOTONIC both). It
+     includes the uplink's delay and queueing, not the way back.
+   - spurious_stops_per_min: zero Twists following a non-zero one while the stick is held, per
+     minute held, leaving out those from an outage's start to 1 s after its end (an outage must
+     stop the robot).
+   - video_fps, frame_age_p50/p99_ms: frames received per second; age = the frame's last byte
+     in this process (wall clock) − the time code the simulated camera drew into it (its wall
+     clock at capture, rover_web/sim/timecode.py, read from the decoded JPEG): glass to glass.
+   - event_age_p99_ms: odom SSE frames, kernel arrival time (wall) − the Odometry header stamp
+     (the simulator's wall clock at publish).
+2. E-stop phase (`--estops` times, for at most 120 s; the stick released, camera and events still
+   flowing): POST /api/estop {"engaged": true} timed to its answer (estop_rtt_*), then a timed
+   release. A POST unanswered after 30 s counts as 30 s and is counted (estop_timeouts).
+link_rtt_ms is the profile's nominal round trip (2 × one-way delay); link_rtt_measured_ms is the
+median of 10 GET /api/estop on the idle link before the hold phase (a small request and answer).
+"""
+
+from __future__ import annotations
+
+import argparse
+import bisect
+import io
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+import requests
+from common import ROOT, WALL_MINUS_MONOTONIC, Server, SseFleet, machine, percentile, ros_env
+
+sys.path.insert(0, str(ROOT))
+from teleop import Subscriber, connect, encoded, frame, hang_up  # noqa: E402
+
+from rover_web import config as config_module  # noqa: E402
+from rover_web.linkemu import PROFILES, LinkEmulator, profile  # noqa: E402
+from rover_web.sim import timecode  # noqa: E402
+from tests.support.mjpeg import MjpegClient  # noqa: E402
+
+TOPIC = "/camera/image_raw"
+STICK_HZ = 25.0
+VALUES = 500  # distinct stick values, then they repeat (20 s at 25 Hz)
+MAX_LINEAR = 5.0  # ROVER_WEB_MAX_LINEAR_MPS's default: the Twist is the stick's fraction of it
+OUTAGE_GRACE_S = 1.0  # stops up to this long after an outage are the outage's
+
+
+def stick_value(i: int) -> float:
+    return round(0.3 + (i % VALUES + 1) / 2000, 6)
+
+
+def value_index(linear: float) -> int | None:
+    k = round((linear / MAX_LINEAR - 0.3) * 2000) - 1
+    return k if 0 <= k < VALUES else None
+
+
+class Stick(threading.Thread):
+    """The operator's thumb on the stick: a frame every 1/STICK_HZ s, each a new value, with the
+    epoch the server last said (a deadman stop starts a new one)."""
+
+    def __init__(self, ws):
+        super().__init__(daemon=True)
+        self.ws = ws
+        self.sent: list[tuple[float, int]] = []  # (monotonic, value index)
+        self.lost_at: float | None = None  # when the socket failed under the stick, if it did
+        self.running = threading.Event()
+        self.running.set()
+
+    def run(self) -> None:
+        period, start, i = 1 / STICK_HZ, time.monotonic(), 0
+        while self.running.is_set():
+            while (wait := start + i * period - time.monotonic()) > 0:
+                time.sleep(wait)
+            data = encoded(frame(stick_value(i), epoch=self.ws.heard.epoch))
+            t = time.monotonic()
+            try:
+                self.ws.sock.sendall(data)
+            except OSError:
+                self.lost_at = time.monotonic()  # the server closed it: reported, not retried
+                return
+            self.sent.append((t, i % VALUES))
+            i += 1
+
+    def release(self) -> None:
+        self.running.clear()
+        self.join(5)
+        if self.lost_at is None:
+            try:
+                self.ws.send(json.dumps({"stop": True}))
+            except OSError:
+                self.lost_at = time.monotonic()
+
+
+def teleop_latencies(sent: list[tuple[float, int]], twists: list[tuple[float, float, float]]) -> list[float]:
+    """Each frame's latency: its send → the first Twist with its value before that value is sent again."""
+    arrivals: dict[int, list[float]] = {}
+    for t, lin, _ in twists:
+        if (k := value_index(lin)) is not None:
+            arrivals.setdefault(k, []).append(t)
+    out = []
+    next_send: dict[int, float] = {}
+    for t_sent, k in reversed(sent):
+        times = arrivals.get(k, [])
+        j = bisect.bisect_left(times, t_sent)
+        if j < len(times) and times[j] < next_send.get(k, float("inf")):
+            out.append(times[j] - t_sent)
+        next_send[k] = t_sent
+    return out
+
+
+def spurious_stops(twists, start: float, end: float, outages: list[tuple[float, float]]) -> tuple[int, int]:
+    """(stops outside outages, stops inside them): zero Twists after a non-zero one within [start, end]."""
+    outside = inside = 0
+    moving = False
+    for t, lin, ang in twists:
+        zero = lin == 0.0 and ang == 0.0
+        if zero and moving and start <= t <= end:
+            if any(a <= t <= b + OUTAGE_GRACE_S for a, b in outages):
+                inside += 1
+            else:
+                outside += 1
+        moving = not zero
+    return outside, inside
+
+
+class Viewer:
+    """An MJPEG viewer through the link; a thread decodes each frame's time code as frames arrive."""
+
+    def __init__(self, url: str):
+        self.client = MjpegClient(f"{url}/stream?topic={TOPIC}")
+        self.samples: list[tuple[float, float | None, int]] = []  # (arrival monotonic, age ms or None, bytes)
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._decode, daemon=True)
+        self._thread.start()
+
+    def _decode(self) -> None:
+        import numpy as np
+        from PIL import Image
+
+        while not self._stop.wait(0.1):
+            with self.client._cond:  # the reader appends under this lock: take what it has so far
+                frames, self.client.frames = self.client.frames, []
+            for t_arrived, _headers, data in frames:
+                try:
+                    pixels = np.asarray(Image.open(io.BytesIO(data)).convert("RGB"))
+                    arrived_ms = (t_arrived + WALL_MINUS_MONOTONIC) * 1000
+                    stamp = timecode.read(pixels, now_ms=int(arrived_ms))
+                except OSError:
+                    stamp = None
+                self.samples.append((t_arrived, None if stamp is None else arrived_ms - stamp, len(data)))
+
+    def window(self, start: float, end: float) -> list[tuple[float, float | None, int]]:
+        return [s for s in self.samples if start <= s[0] <= end]
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join(5)
+        self.client.close()
+
+
+class Events(threading.Thread):
+    """An SSE client on the odom channel through the link: (arrival monotonic, age ms) per frame."""
+
+    def __init__(self, url: str):
+        super().__init__(daemon=True)
+        self.fleet = SseFleet(url, "/api/events?channels=odom")
+        self.ages: list[tuple[float, float]] = []
+        self.running = threading.Event()
+        self.running.set()
+
+    def run(self) -> None:
+        def on_event(_woken, arrived, name, data):
+            if name == "odom" and isinstance(data.get("stamp"), (int, float)):
+                self.ages.append((arrived, ((arrived + WALL_MINUS_MONOTONIC) - data["stamp"]) * 1000))
+
+        while self.running.is_set():
+            self.fleet.poll(0.5, on_event)
+
+    def close(self) -> None:
+        self.running.clear()
+        self.join(5)
+        self.fleet.close()
+
+
+def wait_for(predicate, timeout: float, what: str):
+    deadline = time.monotonic() + timeout
+    while not (value := predicate()):
+        if time.monotonic() > deadline:
+            raise RuntimeError(f"{what} did not happen within {timeout} s")
+        time.sleep(0.1)
+    return value
+
+
+def ms(values: list[float], p: float) -> float | None:
+    return round(percentile(values, p), 1) if values else None
+
+
+ESTOP_TIMEOUT_S = 30.0
+ESTOP_BUDGET_S = 120.0  # the phase stops starting trials after this long (a clogged link takes ~30 s each)
+
+
+def estop_trials(url: str, n: int) -> tuple[list[float], list[float], int]:
+    """n × (engage, then release), each POST timed; a Session keeps its connection, as a page does.
+    A POST unanswered after ESTOP_TIMEOUT_S counts as that long (and is counted): the p99 is then a
+    lower bound."""
+    engage, release, timeouts = [], [], 0
+    start = time.monotonic()
+
+    def timed(session, engaged: bool) -> float:
+        nonlocal timeouts
+        t0 = time.monotonic()
+        try:
+            session.post(url + "/api/estop", json={"engaged": engaged, "by": "bench"},
+                         timeout=ESTOP_TIMEOUT_S).raise_for_status()
+        except requests.Timeout:
+            timeouts += 1
+            return ESTOP_TIMEOUT_S * 1000
+        return (time.monotonic() - t0) * 1000
+
+    with requests.Session() as session:
+        for _ in range(n):
+            if time.monotonic() - start > ESTOP_BUDGET_S:
+                break
+            engage.append(timed(session, True))
+            time.sleep(0.3)
+            release.append(timed(session, False))
+            time.sleep(0.7)
+    return engage, release, timeouts
+
+
+def link_rtt(url: str) -> float:
+    times = []
+    with requests.Session() as session:
+        session.get(url + "/api/estop", timeout=30)  # the connection, once
+        for _ in range(10):
+            t0 = time.monotonic()
+            session.get(url + "/api/estop", timeout=30).raise_for_status()
+            times.append((time.monotonic() - t0) * 1000)
+    return statistics.median(times)
+
+
+def adapt_setting(adapt: str | None) -> tuple[dict[str, str], str]:
+    """ROVER_WEB_CAMERA_ADAPT when this build has it (issue 25's video adaptation)."""
+    if adapt is None:
+        return {}, "default"
+    if not any(s.name == "CAMERA_ADAPT" for s in config_module.SETTINGS):
+        print(f"# --adapt {adapt}: this build has no ROVER_WEB_CAMERA_ADAPT; running without it", flush=True)
+        return {}, "n/a"
+    return {"ROVER_WEB_CAMERA_ADAPT": "true" if adapt == "on" else "false"}, adapt
+
+
+def bench_profile(name: str):
+    """A named profile, or `loopback`: no limits at all, what the machine alone costs (a control)."""
+    if name == "loopback":
+        return profile("custom", rate_kbps=1_000_000, delay_ms=0, buffer_kb=4096)
+    return profile(name)
+
+
+def run(args) -> dict:
+    link = bench_profile(args.profile)
+    load_before = os.getloadavg()[0]
+    scratch = tempfile.TemporaryDirectory(prefix="rover_web-bench-link-")
+    extra, adapt = adapt_setting(args.adapt)
+    env = ros_env(ROVER_WEB_DB_PATH=os.path.join(scratch.name, "bench.sqlite3"), **extra)
+    print(f"# link bench on {machine()}: {link.describe()}; camera {args.camera}, adapt {adapt}; "
+          f"ROS domain {env['ROS_DOMAIN_ID']}", flush=True)
+    sim = subprocess.Popen([sys.executable, "-m", "rover_web.sim"], cwd=ROOT, env=env,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    server = sub = emu = ws = viewer = events = None
+    try:
+        server = Server(env)
+        sub = Subscriber(env)
+        emu = LinkEmulator(link, "127.0.0.1:0", ("127.0.0.1", server.port), seed=args.seed).start()
+        url = f"http://127.0.0.1:{emu.port}"
+        measured_rtt = link_rtt(url)
+        events = Events(url)
+        events.start()
+        wait_for(lambda: events.ages, 60, "the first odom event through the link")
+        ws = connect(url)  # before the video: its handshake would otherwise queue behind seconds of frames
+        if args.camera == "on":
+            viewer = Viewer(url)
+            wait_for(lambda: viewer.samples, 60, "the first camera frame through the link")
+        stick = Stick(ws)
+        mark = sub.mark()
+        stick.start()
+        time.sleep(2.0)  # settle: the first frames, the video's queue filling
+        t_start = time.monotonic()
+        time.sleep(args.seconds)
+        t_end = time.monotonic()
+        stick.release()
+        twists = sub.since(mark)
+        said = dict(ws.heard.counts)
+        t_estop = time.monotonic()
+        engage, release, estop_timeouts = estop_trials(url, args.estops)
+        t_estop_end = time.monotonic()
+        windows = emu.windows()
+        counters = emu.counters()
+    finally:
+        for part in (viewer, events):
+            if part is not None:
+                part.close()
+        if ws is not None:
+            hang_up(ws)
+        if emu is not None:
+            emu.stop()
+        if sub is not None:
+            sub.stop()
+        if server is not None:
+            server.stop()
+        sim.terminate()
+        try:
+            sim.wait(10)
+        except subprocess.TimeoutExpired:
+            sim.kill()
+        scratch.cleanup()
+
+    held_s = t_end - t_start
+    outages = [(a, b) for a, b, kind in windows if kind == "outage"]
+    latencies = [x * 1000 for x in teleop_latencies([s for s in stick.sent if t_start <= s[0] <= t_end],
+                                                    twists)]
+    stops_out, stops_in = spurious_stops(twists, t_start, t_end, outages)
+    frames = viewer.window(t_start, t_end) if viewer else []
+    ages = [age for _, age, _ in frames if age is not None]
+    estop_frames = viewer.window(t_estop, t_estop_end) if viewer else []
+    event_ages = [age for t, age in events.ages if t_start <= t <= t_end]
+    result = {
+        "profile": args.profile,
+        "camera": args.camera,
+        "video": args.video,
+        "adapt": adapt,
+        "seconds": round(held_s, 1),
+        "link_rtt_ms": link.rtt_ms,
+        "link_rtt_measured_ms": round(measured_rtt, 1),
+        "teleop_p50_ms": ms(latencies, 50),
+        "teleop_p99_ms": ms(latencies, 99),
+        "teleop_frames_matched": f"{len(latencies)}/{sum(1 for s in stick.sent if t_start <= s[0] <= t_end)}",
+        "spurious_stops_per_min": round(stops_out / (held_s / 60), 2),
+        "stops_in_outages": stops_in,
+        "server_said": said,
+        "teleop_socket_lost_at_s": None if stick.lost_at is None else round(stick.lost_at - t_start, 1),
+        "estop_trials": len(engage),
+        "estop_timeouts": estop_timeouts,
+        "estop_rtt_p50_ms": ms(engage, 50),
+        "estop_rtt_p99_ms": ms(engage, 99),
+        "estop_release_p99_ms": ms(release, 99),
+        "video_fps": round(len(frames) / held_s, 2),
+        "video_kbps": round(sum(b for _, _, b in frames) * 8 / held_s / 1000, 1),
+        "frames_unreadable": sum(1 for _, age, _ in frames if age is None),
+        "frame_age_p50_ms": ms(ages, 50),
+        "frame_age_p99_ms": ms(ages, 99),
+        "video_fps_during_estops": round(len(estop_frames) / max(1e-9, t_estop_end - t_estop), 2),
+        "event_age_p50_ms": ms(event_ages, 50),
+        "event_age_p99_ms": ms(event_ages, 99),
+        "events_per_s": round(len(event_ages) / held_s, 2),
+        "stalls": counters["stalls"],
+        "outages": counters["outages"],
+        "down_queue_peak_kb": round(counters["down"]["queue_peak"] / 1000, 1),
+        "seed": emu.seed,
+        "load_avg": [round(load_before, 1), round(os.getloadavg()[0], 1)],  # the machine's, start and end
+    }
+    return result
+
+
+def table(r: dict) -> str:
+    def f(v, unit=""):
+        return "—" if v is None else f"{v}{unit}"
+    rows = [
+        ("link", f"{r['profile']}: nominal RTT {r['link_rtt_ms']:g} ms, measured {r['link_rtt_measured_ms']} ms; "
+                 f"{r['stalls']} stalls, {r['outages']} outages in the run; downlink queue peak "
+                 f"{r['down_queue_peak_kb']} kB; load average {r['load_avg'][0]} → {r['load_avg'][1]}"),
+        ("teleop frame → /cmd_vel", f"p50 {f(r['teleop_p50_ms'], ' ms')}, p99 {f(r['teleop_p99_ms'], ' ms')} "
+                                    f"({r['teleop_frames_matched']} frames matched)"),
+        ("spurious stops", f"{r['spurious_stops_per_min']} per minute held ({r['stops_in_outages']} more "
+                           f"during outages); server said {r['server_said'] or 'nothing'}"
+                           + ("" if r["teleop_socket_lost_at_s"] is None
+                              else f"; the teleop socket was lost {r['teleop_socket_lost_at_s']} s into the hold")),
+        ("e-stop POST round trip", f"p50 {f(r['estop_rtt_p50_ms'], ' ms')}, p99 {f(r['estop_rtt_p99_ms'], ' ms')}; "
+                                   f"release p99 {f(r['estop_release_p99_ms'], ' ms')} ({r['estop_trials']} trials"
+                                   + (f", {r['estop_timeouts']} POSTs unanswered after {ESTOP_TIMEOUT_S:g} s"
+                                      if r["estop_timeouts"] else "") + ")"),
+        ("video", f"{r['video_fps']} fps, {r['video_kbps']} kbit/s, frame age p50 {f(r['frame_age_p50_ms'], ' ms')}"
+                  f", p99 {f(r['frame_age_p99_ms'], ' ms')} ({r['frames_unreadable']} unreadable)"),
+        ("odom events", f"{r['events_per_s']} /s, age p50 {f(r['event_age_p50_ms'], ' ms')}, "
+                        f"p99 {f(r['event_age_p99_ms'], ' ms')}"),
+    ]
+    width = max(len(k) for k, _ in rows)
+    return "\n".join(f"{k:<{width}}  {v}" for k, v in rows)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--profile", choices=[*PROFILES, "loopback"], default="wifi-edge",
+                        help="the link; loopback: the emulator with no limits, a control for the machine's own noise")
+    parser.add_argument("--camera", choices=("on", "off"), default="on")
+    parser.add_argument("--video", choices=("mjpeg", "webrtc"), default="mjpeg")
+    parser.add_argument("--adapt", choices=("on", "off"), default=None,
+                        help="sets ROVER_WEB_CAMERA_ADAPT on the app (default: the app's default)")
+    parser.add_argument("--seconds", type=float, default=60.0, help="how long the stick is held")
+    parser.add_argument("--estops", type=int, default=10, help="e-stop engage/release trials after the hold")
+    parser.add_argument("--seed", type=int, default=1, help="the emulator's random seed (stalls, jitter)")
+    args = parser.parse_args()
+    if args.video == "webrtc":
+        print("bench/link.py: --video webrtc is not available yet (the WebRTC path is issue 25's next part)",
+              file=sys.stderr)
+        return 2
+    result = run(args)
+    print(table(result), flush=True)
+    print(json.dumps(result), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
