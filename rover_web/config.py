@@ -73,6 +73,17 @@ SETTINGS: tuple[Setting, ...] = (
             "PEM certificate for HTTPS (the demo and gunicorn.conf.py); `flask tls self-signed` writes one"),
     Setting("TLS_KEY", None, "optional_str", "PEM private key that goes with ROVER_WEB_TLS_CERT"),
     Setting("MAX_BODY_BYTES", 262144, "int", "largest request body accepted (413 beyond)", 1024, 64 * 1024 * 1024),
+    # --- sign-in work (docs/security.md#what-a-sign-in-may-cost) ---
+    Setting("SIGNIN_MAX_HASHING", 2, "int",
+            "password hashes computed at once; a sign-in beyond them is answered 503 at once, unhashed", 1, 64),
+    Setting("SIGNIN_ATTEMPTS_PER_MIN", 10, "int",
+            "sign-in attempts one client address may make in a sliding minute, across all names (429 beyond)",
+            1, 10000),
+    Setting("ARGON2_MEMORY_KIB", 19456, "int",
+            "Argon2id memory per password hash, KiB (OWASP: 19456 with 2 passes, or 12288 with 3)", 8192, 1048576),
+    Setting("ARGON2_TIME_COST", 2, "int", "Argon2id passes per password hash", 1, 20),
+    Setting("LOGIN_ESTOP", True, "bool",
+            "the sign-in page offers a button that engages (never releases) every robot's e-stop, to anyone"),
     # --- live events and link health ---
     Setting("SSE_KEEPALIVE_S", 10.0, "float", "seconds between SSE keep-alive comments (at most 15)", 0.05, 15),
     Setting("SSE_RETRY_MS", 1000, "int", "reconnect delay the SSE stream asks browsers to use", 100, 60000),

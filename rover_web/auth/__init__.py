@@ -36,7 +36,7 @@ class _SessionInterface(SecureCookieSessionInterface):
 
 
 def init_app(app: Flask, rover: Rover) -> None:
-    service = AuthService(rover.db, rover.config["ROVER_WEB_AUTH"], process.listen_hosts(rover.config))
+    service = AuthService(rover.db, rover.config["ROVER_WEB_AUTH"], process.listen_hosts(rover.config), rover.config)
     service.check_startable()
     rover.add_feature(service)
     app.secret_key = secret_key(rover.config["ROVER_WEB_SECRET_KEY"], app.instance_path)
