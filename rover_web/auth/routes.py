@@ -8,7 +8,7 @@ from urllib.parse import unquote, urlsplit
 from flask import Blueprint, jsonify, make_response, redirect, render_template, request, url_for
 from flask_login import current_user, login_user, logout_user
 
-from rover_web.core.state import current_feature
+from rover_web.core.state import current_feature, current_rover
 from rover_web.web.http import ApiError, accepts_form, error_response, json_body, wants_json
 from rover_web.web.validate import InvalidInput, only_keys, text
 
@@ -85,7 +85,12 @@ def _safe_next(target: object) -> str:
 def login_form():
     if current_user.is_authenticated:
         return redirect(_safe_next(request.args.get("next")))
-    return render_template("login.html", next=_safe_next(request.args.get("next")), error=None, username="")
+    return _login_page(_safe_next(request.args.get("next")), None, "")
+
+
+def _login_page(next_path: str, error: str | None, username: str) -> str:
+    return render_template("login.html", next=next_path, error=error, username=username,
+                           login_estop=current_rover().config["ROVER_WEB_LOGIN_ESTOP"])
 
 
 @bp.post("/login")
@@ -125,7 +130,7 @@ def _login_refused(as_json: bool, status: int, code: str, message: str, username
     if as_json:
         response = error_response(status, code, message)
     else:
-        html = render_template("login.html", next=next_path, error=message, username=username)
+        html = _login_page(next_path, message, username)
         response = make_response(html, status, {"Content-Type": "text/html; charset=utf-8"})
     if retry_after_s is not None:
         response.headers["Retry-After"] = str(max(1, int(retry_after_s + 0.999)))
