@@ -217,6 +217,9 @@ SETTINGS: tuple[Setting, ...] = (
             1, 1024),
     # --- observability: /rosout, diagnostics, plots ---
     Setting("ROSOUT_KEEP", 5000, "int", "/rosout lines kept in memory (oldest dropped)", 10, 1000000),
+    Setting("ROSOUT_KEEP_BYTES", 16 * 1024 * 1024, "int",
+            "most bytes of /rosout text kept in memory (oldest lines dropped); each line is cut on arrival",
+            64 * 1024, 1024 * 1024 * 1024),
     Setting("DIAGNOSTICS_STALE_S", 5.0, "float", "a diagnostic status older than this is stale",
             0.1, 3600),
     Setting("PLOT_KEEP_POINTS", 20000, "int", "samples kept per plotted series", 100, 1000000),
