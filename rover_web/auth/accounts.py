@@ -120,10 +120,7 @@ class Accounts:
 
     def _hash(self, password: str) -> str:
         # Admin work (the admin API, the CLI) waits for a slot rather than failing.
-        with self.gate.slot(wait=True):
-            return self._hasher.hash(password)
-
-    # --- users ---
+        return self.gate.run(self._hasher.hash, password, wait=True)
 
     def add_user(self, name: str, role: str, password: str) -> User:
         check_name(name), check_role(role), check_password(password)
@@ -182,18 +179,24 @@ class Accounts:
             return None
         row = self._db.connection().execute(
             "SELECT name, role, password_hash FROM auth_users WHERE name = ?", (name,)).fetchone()
-        with self.gate.slot():
+        stored = row["password_hash"] if row else None
+
+        def check() -> tuple[bool, str | None]:  # on a hashing thread: (verified, a new hash or None)
             try:
-                self._hasher.verify(row["password_hash"] if row else _dummy_hash(self._hasher), password)
+                self._hasher.verify(stored or _dummy_hash(self._hasher), password)
             except (VerificationError, InvalidHashError):
-                return None
-            if row is None:
-                return None
-            if self._hasher.check_needs_rehash(row["password_hash"]):
-                new_hash = self._hasher.hash(password)
-                with self._db.transaction() as conn:
-                    conn.execute("UPDATE auth_users SET password_hash = ? WHERE name = ? AND password_hash = ?",
-                                 (new_hash, name, row["password_hash"]))
+                return False, None
+            if stored is not None and self._hasher.check_needs_rehash(stored):
+                return True, self._hasher.hash(password)
+            return True, None
+
+        verified, new_hash = self.gate.run(check)
+        if not verified or row is None:
+            return None
+        if new_hash is not None:
+            with self._db.transaction() as conn:
+                conn.execute("UPDATE auth_users SET password_hash = ? WHERE name = ? AND password_hash = ?",
+                             (new_hash, name, stored))
         return User(row["name"], row["role"])
 
     # --- API tokens ---

@@ -1,9 +1,12 @@
 """What one sign-in attempt may cost, and who may try again when. Pure Python, monotonic clock.
 
-- `HashGate`: at most `limit` password hashes at once in the whole process. Each Argon2 hash holds
-  its memory cost (19 MiB by default) for tens of milliseconds; eight parallel attempts at 64 MiB
-  took a server from 109 to 633 MB (issue 27). Beyond the limit a sign-in is answered 503 at once,
-  before any hash is computed.
+- `HashGate`: at most `limit` password hashes at once in the whole process, run on `limit`
+  threads of its own. Each Argon2 hash holds its memory cost (19 MiB by default) for tens of
+  milliseconds; eight parallel attempts at 64 MiB took a server from 109 to 633 MB (issue 27).
+  Beyond the limit a sign-in is answered 503 at once, before any hash is computed. Why threads
+  of its own: glibc's malloc keeps a freed block under 32 MiB in the arena of the thread that
+  freed it, and `flask run` serves each request on a new thread, so hashes run on request
+  threads left 19 MiB behind in up to 8 arenas per core; on `limit` fixed threads, at most `limit`.
 - `SignInThrottle`: per client address, at most `attempts_per_min` attempts across all names (a
   sliding minute, `core/rate_limit.py`), and exponential back-off on failures, counted per address
   and per (name, address). A hard lock per name let anyone lock a user out with five wrong
@@ -16,7 +19,9 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
+from typing import TypeVar
 
 from rover_web.core.rate_limit import RateLimit
 
@@ -26,6 +31,8 @@ FREE_FAILURES_PER_NAME = 5  # failures for one name from one address before that
 FIRST_DELAY_S = 1.0  # the first wait; each further failure doubles it ...
 MAX_DELAY_S = 900.0  # ... up to 15 minutes
 FORGET_AFTER_S = 3600.0  # failures older than this (with none since) are forgotten
+
+T = TypeVar("T")
 
 
 class HashingBusy(RuntimeError):
@@ -39,6 +46,8 @@ class HashGate:
     def __init__(self, limit: int):
         self.limit = limit
         self._slots = threading.BoundedSemaphore(limit)
+        # Never more than `limit` tasks in it (the semaphore is taken first): no queue forms.
+        self._pool = ThreadPoolExecutor(max_workers=limit, thread_name_prefix="argon2")
         self._lock = threading.Lock()
         self.active = 0
         self.peak = 0
@@ -62,6 +71,14 @@ class HashGate:
                 self.active -= 1
                 self.hashed += 1
             self._slots.release()
+
+    def run(self, fn: Callable[..., T], *args, wait: bool = False) -> T:
+        """fn(*args) on one of the gate's threads, in a slot; HashingBusy at once when none is free."""
+        with self.slot(wait):
+            return self._pool.submit(fn, *args).result()
+
+    def close(self) -> None:
+        self._pool.shutdown(wait=False)
 
 
 class _Backoff:

@@ -19,7 +19,9 @@ def db(tmp_path):
 
 @pytest.fixture
 def accounts(db):
-    return Accounts(db)
+    made = Accounts(db)
+    yield made
+    made.gate.close()
 
 
 def test_a_user_signs_in_with_their_password_only(accounts):
@@ -137,6 +139,7 @@ def test_a_hash_with_the_old_parameters_still_verifies_and_is_replaced_at_sign_i
     assert accounts.authenticate("ada", "correct horse") == User("ada", "operator")
     assert "$m=12288,t=3,p=1$" in _stored(db)
     assert accounts.authenticate("ada", "correct horse") == User("ada", "operator")
+    old.gate.close(), accounts.gate.close()
 
 
 def test_a_sign_in_with_every_hashing_slot_taken_is_refused_before_any_hash(db):
@@ -150,6 +153,7 @@ def test_a_sign_in_with_every_hashing_slot_taken_is_refused_before_any_hash(db):
             accounts.authenticate("nobody", "correct horse")  # the dummy hash takes a slot too
     assert accounts.gate.hashed == hashed + 1  # only the test's own slot
     assert accounts.authenticate("ada", "correct horse") == User("ada", "operator")
+    accounts.gate.close()
 
 
 def _stored(db) -> str:

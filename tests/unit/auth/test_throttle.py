@@ -135,3 +135,5 @@ def test_the_hash_gate_refuses_at_once_beyond_its_bound_and_counts():
     with gate.slot():
         pass
     assert (gate.peak, gate.hashed, gate.refused, gate.active) == (2, 3, 1, 0)
+    assert gate.run(lambda x: threading.current_thread().name + x, "!").startswith("argon2")  # its own threads
+    gate.close()
