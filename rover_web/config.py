@@ -76,7 +76,7 @@ SETTINGS: tuple[Setting, ...] = (
     # --- sign-in work (docs/security.md#what-a-sign-in-may-cost) ---
     Setting("SIGNIN_MAX_HASHING", 2, "int",
             "password hashes computed at once; a sign-in beyond them is answered 503 at once, unhashed", 1, 64),
-    Setting("SIGNIN_ATTEMPTS_PER_MIN", 10, "int",
+    Setting("SIGNIN_ATTEMPTS_PER_MIN", 20, "int",
             "sign-in attempts one client address may make in a sliding minute, across all names (429 beyond)",
             1, 10000),
     Setting("ARGON2_MEMORY_KIB", 19456, "int",

@@ -21,7 +21,7 @@ ADD_USER_HINT = "flask --app rover_web users add NAME --role admin"
 class AuthService:
     def __init__(self, db, mode: str, listen_hosts: list[str], config: dict | None = None):
         self.accounts = accounts_for(db, config or {})
-        self.throttle = SignInThrottle((config or {}).get("ROVER_WEB_SIGNIN_ATTEMPTS_PER_MIN", 10))
+        self.throttle = SignInThrottle((config or {}).get("ROVER_WEB_SIGNIN_ATTEMPTS_PER_MIN", 20))
         self.mode = mode
         self.listen_hosts = listen_hosts
         self.required = sign_in_required(mode, listen_hosts)

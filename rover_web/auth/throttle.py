@@ -127,7 +127,7 @@ class _Backoff:
 
 
 class SignInThrottle:
-    def __init__(self, attempts_per_min: int = 10, clock: Callable[[], float] = time.monotonic):
+    def __init__(self, attempts_per_min: int = 20, clock: Callable[[], float] = time.monotonic):
         self._clock = clock
         self._attempts = RateLimit(attempts_per_min, 60.0, clock=clock)
         self._by_address = _Backoff(FREE_FAILURES_PER_ADDRESS, clock)

@@ -52,6 +52,8 @@ def estop_all():
     nobody looked at.
     """
     body = json_body(required=False)
+    if body.get("engaged") is True:  # as POST /api/estop: engaging works whatever else the body says
+        return _engage_all(client_name(body.get("by")))
     try:
         only_keys(body, {"engaged", "by"})
         engaged = body.get("engaged", True)
