@@ -36,9 +36,10 @@ class _SessionInterface(SecureCookieSessionInterface):
 
 
 def init_app(app: Flask, rover: Rover) -> None:
-    service = AuthService(rover.db, rover.config["ROVER_WEB_AUTH"], process.listen_hosts(rover.config))
+    service = AuthService(rover.db, rover.config["ROVER_WEB_AUTH"], process.listen_hosts(rover.config), rover.config)
     service.check_startable()
     rover.add_feature(service)
+    rover.on_shutdown(service.accounts.gate.close)  # the password-hashing threads
     app.secret_key = secret_key(rover.config["ROVER_WEB_SECRET_KEY"], app.instance_path)
     app.config.update(SESSION_COOKIE_HTTPONLY=True, SESSION_COOKIE_SAMESITE="Strict")
     app.session_interface = _SessionInterface()

@@ -1,9 +1,12 @@
 """Users, their roles and their API tokens, kept in the app's SQLite database.
 
 Passwords are hashed with Argon2id (argon2-cffi: memory-hard, salted, parameters stored in the hash,
-so they can be raised later and old hashes re-hashed on sign-in). API tokens are random 256-bit
-strings shown once; only their SHA-256 is stored: a token is already high-entropy, so a slow hash
-would only cost every curl request time without adding strength.
+so they can be changed later and old hashes re-hashed on sign-in). The parameters are OWASP's for a
+small computer (19 MiB, 2 passes, 1 lane) rather than argon2-cffi's default (64 MiB, 3 passes,
+4 lanes): a robot's computer has little memory, and every hash runs under a `HashGate` slot.
+API tokens are random 256-bit strings shown once; only their SHA-256 is stored: a token is already
+high-entropy, so a slow hash would only cost every curl request time without adding strength (and a
+token check takes no hashing slot).
 """
 
 from __future__ import annotations
@@ -19,6 +22,8 @@ from dataclasses import dataclass
 
 from argon2 import PasswordHasher
 from argon2.exceptions import InvalidHashError, VerificationError
+
+from .throttle import HashGate, HashingBusy
 
 ROLES = ("viewer", "operator", "admin")
 NAME_PATTERN = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.@-]{0,39}\Z")
@@ -44,15 +49,25 @@ CREATE TABLE IF NOT EXISTS auth_tokens (
 )
 """
 
-_hasher = PasswordHasher()
+# OWASP Password Storage Cheat Sheet, Argon2id: m=19 MiB, t=2, p=1 (or m=12 MiB, t=3).
+ARGON2_MEMORY_KIB = 19 * 1024
+ARGON2_TIME_COST = 2
+ARGON2_PARALLELISM = 1  # one lane: a sign-in never takes more than one core
+DEFAULT_MAX_HASHING = 2
+
+__all__ = ["Accounts", "AccountError", "HashingBusy", "User", "password_hasher"]
+
+
+def password_hasher(memory_kib: int = ARGON2_MEMORY_KIB, time_cost: int = ARGON2_TIME_COST) -> PasswordHasher:
+    return PasswordHasher(time_cost=time_cost, memory_cost=memory_kib, parallelism=ARGON2_PARALLELISM)
 
 
 @functools.cache
-def _dummy_hash() -> str:
+def _dummy_hash(hasher: PasswordHasher) -> str:
     """A hash of a password nobody has, checked when the name is unknown, so that an unknown name
     takes as long to refuse as a wrong password (no user enumeration by timing). Made at the first
-    sign-in, not at start: an Argon2 hash takes 64 MiB and tens of milliseconds."""
-    return _hasher.hash(secrets.token_hex(16))
+    sign-in, not at start: an Argon2 hash takes megabytes and tens of milliseconds."""
+    return hasher.hash(secrets.token_hex(16))
 
 
 class AccountError(ValueError):
@@ -97,15 +112,19 @@ def token_digest(token: str) -> str:
 
 
 class Accounts:
-    def __init__(self, db):
+    def __init__(self, db, hasher: PasswordHasher | None = None, gate: HashGate | None = None):
         self._db = db
+        self._hasher = hasher or password_hasher()
+        self.gate = gate or HashGate(DEFAULT_MAX_HASHING)
         db.ensure_schema(ACCOUNTS_DDL)
 
-    # --- users ---
+    def _hash(self, password: str) -> str:
+        # Admin work (the admin API, the CLI) waits for a slot rather than failing.
+        return self.gate.run(self._hasher.hash, password, wait=True)
 
     def add_user(self, name: str, role: str, password: str) -> User:
         check_name(name), check_role(role), check_password(password)
-        password_hash = _hasher.hash(password)
+        password_hash = self._hash(password)
         try:
             with self._db.transaction() as conn:
                 conn.execute("INSERT INTO auth_users (name, role, password_hash, created_at) VALUES (?, ?, ?, ?)",
@@ -137,7 +156,7 @@ class Accounts:
 
     def set_password(self, name: str, password: str) -> None:
         check_password(password)
-        password_hash = _hasher.hash(password)
+        password_hash = self._hash(password)
         with self._db.transaction() as conn:
             if conn.execute("UPDATE auth_users SET password_hash = ? WHERE name = ?",
                             (password_hash, name)).rowcount == 0:
@@ -150,24 +169,35 @@ class Accounts:
                 raise AccountError(f"no user {name!r}", "no_such_user")
 
     def authenticate(self, name: str, password: str) -> User | None:
-        """The user, if the password is theirs; None otherwise (same time either way)."""
+        """The user, if the password is theirs; None otherwise (same time either way).
+
+        HashingBusy, before any hash is computed, when every hashing slot is taken. A hash made
+        with other parameters (argon2-cffi's old default of 64 MiB, say) still verifies, and is
+        replaced by one with the current parameters, in the same slot.
+        """
         if not isinstance(name, str) or not isinstance(password, str) or len(password) > MAX_PASSWORD_LEN:
             return None
         row = self._db.connection().execute(
             "SELECT name, role, password_hash FROM auth_users WHERE name = ?", (name,)).fetchone()
-        try:
-            _hasher.verify(row["password_hash"] if row else _dummy_hash(), password)
-        except (VerificationError, InvalidHashError):
-            return None
-        if row is None:
-            return None
-        if _hasher.check_needs_rehash(row["password_hash"]):
-            self._rehash(name, password)
-        return User(row["name"], row["role"])
+        stored = row["password_hash"] if row else None
 
-    def _rehash(self, name: str, password: str) -> None:
-        with self._db.transaction() as conn:
-            conn.execute("UPDATE auth_users SET password_hash = ? WHERE name = ?", (_hasher.hash(password), name))
+        def check() -> tuple[bool, str | None]:  # on a hashing thread: (verified, a new hash or None)
+            try:
+                self._hasher.verify(stored or _dummy_hash(self._hasher), password)
+            except (VerificationError, InvalidHashError):
+                return False, None
+            if stored is not None and self._hasher.check_needs_rehash(stored):
+                return True, self._hasher.hash(password)
+            return True, None
+
+        verified, new_hash = self.gate.run(check)
+        if not verified or row is None:
+            return None
+        if new_hash is not None:
+            with self._db.transaction() as conn:
+                conn.execute("UPDATE auth_users SET password_hash = ? WHERE name = ? AND password_hash = ?",
+                             (new_hash, name, stored))
+        return User(row["name"], row["role"])
 
     # --- API tokens ---
 

@@ -13,7 +13,8 @@ from flask.cli import AppGroup
 
 from rover_web.storage.db import Database, database_path
 
-from .accounts import ROLES, AccountError, Accounts
+from .accounts import ROLES, AccountError
+from .service import accounts_for
 
 users = AppGroup("users", help="Users who may sign in, and their roles (viewer, operator, admin).")
 tokens = AppGroup("tokens", help="API tokens for curl and scripts: Authorization: Bearer <token>.")
@@ -24,7 +25,7 @@ tls = AppGroup("tls", help="Certificates for HTTPS.")
 def _accounts():
     db = Database(database_path(current_app))
     try:
-        yield Accounts(db)
+        yield accounts_for(db, current_app.config)  # the server's Argon2 parameters
     except AccountError as exc:
         raise click.ClickException(str(exc)) from None
     finally:

@@ -19,7 +19,8 @@ PATHS = {
             form=obj({"username": {"type": "string"}, "password": {"type": "string"}, "next": {"type": "string"}},
                      closed=False),
             errors={400: "missing_field, bad_json", 401: "bad_credentials",
-                    429: "too_many_attempts (with Retry-After)"},
+                    429: "too_many_attempts (with Retry-After)",
+                    503: "busy: every password-hashing slot is taken (with Retry-After; no hash computed)"},
             description="A form post answers with a redirect (303) or the form again; JSON answers JSON."),
     },
     "/logout": {

@@ -21,7 +21,8 @@ from .accounts import ROLES
 MODES = ("auto", "required", "off")
 READ_METHODS = frozenset({"GET", "HEAD", "OPTIONS"})
 # Reachable without signing in: the sign-in form itself and the files it needs.
-PUBLIC_ENDPOINTS = frozenset({"auth.login_form", "auth.login", "static"})
+# estop.login_estop: the sign-in page's engage-only e-stop (docs/security.md#the-sign-in-pages-e-stop).
+PUBLIC_ENDPOINTS = frozenset({"auth.login_form", "auth.login", "estop.login_estop", "static"})
 # Any signed-in user, whatever the method.
 # estop_set: the view checks release; estop_all only engages: whoever may watch may stop every robot.
 ANY_USER_ENDPOINTS = frozenset({"auth.logout", "estop.estop_set", "estop.estop_all"})

@@ -3,14 +3,16 @@ check every request passes before its view runs."""
 
 from __future__ import annotations
 
+from urllib.parse import unquote, urlsplit
+
 from flask import Blueprint, jsonify, make_response, redirect, render_template, request, url_for
 from flask_login import current_user, login_user, logout_user
 
-from rover_web.core.state import current_feature
+from rover_web.core.state import current_feature, current_rover
 from rover_web.web.http import ApiError, accepts_form, error_response, json_body, wants_json
 from rover_web.web.validate import InvalidInput, only_keys, text
 
-from .accounts import AccountError, check_password, check_role
+from .accounts import AccountError, HashingBusy, check_password, check_role
 from .identity import SignedIn
 from .policy import required_role, role_allows
 from .service import AuthService
@@ -54,11 +56,27 @@ def require_role(role: str) -> None:
         raise ApiError(403, "forbidden", f"this needs the {role} role; {current_user.name} is a {current_user.role}")
 
 
-def _safe_next(target: str | None) -> str:
-    # Only a path on this server: never an open redirect to another site.
-    if target and target.startswith("/") and not target.startswith("//") and "\\" not in target:
-        return target
-    return request.script_root + "/"
+MAX_NEXT_LEN = 2000
+
+
+def _safe_next(target: object) -> str:
+    """`target` if it is a path on this server, else the robot's own page: never an open redirect.
+
+    Browsers drop tabs and line breaks inside a URL and read a backslash as a slash, so
+    `/<tab>/evil.example` is `//evil.example`, another site; a line break in a Location header is
+    an error (it was a 500). So: one leading `/`, then no `/` or `\\` right after it, no backslash
+    and no control character anywhere, also once percent-decoded, and no scheme or host.
+    """
+    default = request.script_root + "/"
+    if not isinstance(target, str) or not target.startswith("/") or len(target) > MAX_NEXT_LEN:
+        return default
+    for form in (target, unquote(target)):
+        if form.startswith(("//", "/\\")) or "\\" in form or not form.isprintable():
+            return default
+    parts = urlsplit(target)
+    if parts.scheme or parts.netloc:
+        return default
+    return target
 
 
 # --- sign-in ---
@@ -67,7 +85,12 @@ def _safe_next(target: str | None) -> str:
 def login_form():
     if current_user.is_authenticated:
         return redirect(_safe_next(request.args.get("next")))
-    return render_template("login.html", next=_safe_next(request.args.get("next")), error=None, username="")
+    return _login_page(_safe_next(request.args.get("next")), None, "")
+
+
+def _login_page(next_path: str, error: str | None, username: str) -> str:
+    return render_template("login.html", next=next_path, error=error, username=username,
+                           login_estop=current_rover().config["ROVER_WEB_LOGIN_ESTOP"])
 
 
 @bp.post("/login")
@@ -81,30 +104,37 @@ def login():
     if not isinstance(username, str) or not isinstance(password, str) or not username or not password:
         return _login_refused(as_json, 400, "missing_field", "enter a user name and a password", "", next_path)
     username = username.strip()[:80]
-    wait_s = auth.throttle.retry_after_s(username)
+    address = request.remote_addr or "unknown"
+    wait_s, why = auth.throttle.admit(username, address)
     if wait_s > 0:
-        response = _login_refused(as_json, 429, "too_many_attempts",
-                                  f"too many failed sign-ins for {username!r}: try again in {wait_s:.0f} s",
-                                  username, next_path)
-        response.headers["Retry-After"] = str(int(wait_s + 0.999))
-        return response
-    user = auth.accounts.authenticate(username, password)
+        return _login_refused(as_json, 429, "too_many_attempts", f"{why}: try again in {wait_s:.0f} s",
+                              username, next_path, retry_after_s=wait_s)
+    try:
+        user = auth.accounts.authenticate(username, password)
+    except HashingBusy:
+        # Refused before any hash is computed: the server's memory is bounded, not the queue's wait.
+        return _login_refused(as_json, 503, "busy", "the server is checking other sign-ins: try again in a second",
+                              username, next_path, retry_after_s=1)
     if user is None:
-        auth.throttle.failed(username)
+        auth.throttle.failed(username, address)
         return _login_refused(as_json, 401, "bad_credentials", "wrong user name or password", username, next_path)
-    auth.throttle.succeeded(username)
+    auth.throttle.succeeded(username, address)
     login_user(SignedIn(user.name, user.role, "session"))
     if as_json:
         return jsonify(user=user.name, role=user.role)
     return redirect(next_path, 303)
 
 
-def _login_refused(as_json: bool, status: int, code: str, message: str, username: str, next_path: str):
+def _login_refused(as_json: bool, status: int, code: str, message: str, username: str, next_path: str,
+                   retry_after_s: float | None = None):
     if as_json:
-        return error_response(status, code, message)
-    html = render_template("login.html", next=next_path, error=message, username=username)
-    # A Response, not a (body, status, headers) tuple: the caller may add headers (Retry-After).
-    return make_response(html, status, {"Content-Type": "text/html; charset=utf-8"})
+        response = error_response(status, code, message)
+    else:
+        html = _login_page(next_path, message, username)
+        response = make_response(html, status, {"Content-Type": "text/html; charset=utf-8"})
+    if retry_after_s is not None:
+        response.headers["Retry-After"] = str(max(1, int(retry_after_s + 0.999)))
+    return response
 
 
 @bp.post("/logout")

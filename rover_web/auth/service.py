@@ -9,9 +9,9 @@ from pathlib import Path
 
 from rover_web.config import ConfigError
 
-from .accounts import Accounts
+from .accounts import ARGON2_MEMORY_KIB, ARGON2_TIME_COST, DEFAULT_MAX_HASHING, Accounts, password_hasher
 from .policy import sign_in_required
-from .throttle import LoginThrottle
+from .throttle import HashGate, SignInThrottle
 
 log = logging.getLogger(__name__)
 
@@ -19,9 +19,9 @@ ADD_USER_HINT = "flask --app rover_web users add NAME --role admin"
 
 
 class AuthService:
-    def __init__(self, db, mode: str, listen_hosts: list[str]):
-        self.accounts = Accounts(db)
-        self.throttle = LoginThrottle(max_failures=5, window_s=60.0, lockout_s=60.0)
+    def __init__(self, db, mode: str, listen_hosts: list[str], config: dict | None = None):
+        self.accounts = accounts_for(db, config or {})
+        self.throttle = SignInThrottle((config or {}).get("ROVER_WEB_SIGNIN_ATTEMPTS_PER_MIN", 20))
         self.mode = mode
         self.listen_hosts = listen_hosts
         self.required = sign_in_required(mode, listen_hosts)
@@ -42,6 +42,13 @@ class AuthService:
             return ("ROVER_WEB_AUTH=off: anyone who can reach this server can drive the robot, take control "
                     "and release the e-stop")
         return None
+
+
+def accounts_for(db, config) -> Accounts:
+    """Accounts with the configured Argon2 parameters and hashing bound (the server and the CLI)."""
+    hasher = password_hasher(config.get("ROVER_WEB_ARGON2_MEMORY_KIB", ARGON2_MEMORY_KIB),
+                             config.get("ROVER_WEB_ARGON2_TIME_COST", ARGON2_TIME_COST))
+    return Accounts(db, hasher, HashGate(config.get("ROVER_WEB_SIGNIN_MAX_HASHING", DEFAULT_MAX_HASHING)))
 
 
 def secret_key(configured: str | None, instance_path: str) -> str:

@@ -8,10 +8,12 @@ browser. A team with its own CA uses its own certificate and key (ROVER_WEB_TLS_
 
 from __future__ import annotations
 
+import contextlib
 import datetime
 import ipaddress
 import os
 import socket
+import tempfile
 from pathlib import Path
 
 from cryptography import x509
@@ -77,11 +79,26 @@ def write_self_signed(directory: Path, hosts: list[str]) -> tuple[Path, Path]:
     ca_path, cert_path, key_path = directory / "ca.pem", directory / "cert.pem", directory / "key.pem"
     key_bytes = key.private_bytes(serialization.Encoding.PEM, serialization.PrivateFormat.PKCS8,
                                   serialization.NoEncryption())
-    # Created with 0600 from the start: never world-readable, not even for an instant.
-    fd = os.open(key_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-    with os.fdopen(fd, "wb") as f:
-        f.write(key_bytes)
-    os.chmod(key_path, 0o600)
-    ca_path.write_bytes(ca.public_bytes(serialization.Encoding.PEM))
-    cert_path.write_bytes(cert.public_bytes(serialization.Encoding.PEM))
+    _replace(key_path, key_bytes, 0o600)
+    _replace(ca_path, ca.public_bytes(serialization.Encoding.PEM), 0o644)
+    _replace(cert_path, cert.public_bytes(serialization.Encoding.PEM), 0o644)
     return cert_path, key_path
+
+
+def _replace(path: Path, data: bytes, mode: int) -> None:
+    """Write a new file beside `path` (mkstemp: 0600 from the first byte, then `mode`) and rename it
+    over `path`. Opening `path` itself would follow a symlink planted there (and write the key
+    wherever it points) and keep an old file's looser mode until a chmod; a rename replaces the
+    name, never what it pointed to, and the key is never readable by others for an instant."""
+    fd, temp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.chmod(temp, mode)
+        os.replace(temp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(temp)
+        raise

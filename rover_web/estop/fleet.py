@@ -9,12 +9,17 @@ from __future__ import annotations
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 
+from rover_web.core.rate_limit import RateLimit
+
 from .service import EStopService
+
+PUBLIC_ENGAGES_PER_MIN = 6  # from the sign-in page, per client address
 
 
 class FleetEStop:
     def __init__(self, robots: dict[str, EStopService]):
         self.robots = robots  # robot name -> its e-stop, in the order of ROVER_WEB_ROBOTS
+        self.public_engages = RateLimit(PUBLIC_ENGAGES_PER_MIN, 60.0)  # POST /login/estop, by address
 
     @property
     def engaged(self) -> bool:

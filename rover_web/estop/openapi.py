@@ -24,11 +24,24 @@ PATHS = {
             ok=obj({"engaged": {"type": "boolean"},
                     "robots": {"type": "object", "additionalProperties": STATE,
                                "description": "each robot's latch, by robot name"}}),
-            body=obj({"by": {"type": ["string", "null"], "maxLength": 40, "description": "who, when sign-in is off"}}),
+            body=obj({"engaged": {"const": True, "description": "optional; false is refused: release is per robot"},
+                      "by": {"type": ["string", "null"], "maxLength": 40, "description": "who, when sign-in is off"}}),
             body_required=False,
-            errors={400: "bad_json, non_finite, unknown_field, bad_type, too_long"},
+            errors={400: "bad_json, non_finite, unknown_field, bad_type, too_long, release_per_robot"},
             description="Any signed-in user may stop every robot; each is released on its own "
-                        "(`POST /robots/<name>/api/estop`).",
+                        "(`POST /robots/<name>/api/estop`): `{\"engaged\": false}` here is a 400.",
+            fuzz="last", fuzz_why="engaged, it turns every motion route into a 409 for the rest of the run"),
+    },
+    "/login/estop": {
+        "post": op(
+            "The sign-in page's e-stop: engage every robot, without signing in", tag="estop", public=True,
+            ok=obj({"engaged": {"type": "boolean"},
+                    "robots": {"type": "object", "additionalProperties": STATE}}),
+            body=obj(closed=False), body_required=False, form=obj(closed=False),
+            errors={403: "foreign_origin", 404: "not_found (ROVER_WEB_LOGIN_ESTOP off)",
+                    429: "rate_limited (6 a minute per address, with Retry-After)"},
+            description="Engages only, never releases. A form post gets the sign-in page back with a notice; "
+                        "JSON gets the robots' latches. Who engaged is recorded as the client's address.",
             fuzz="last", fuzz_why="engaged, it turns every motion route into a 409 for the rest of the run"),
     },
 }

@@ -1,12 +1,13 @@
-"""GET /api/estop (the latch), POST /api/estop ({"engaged": true|false}), POST /api/estop/all."""
+"""GET /api/estop (the latch), POST /api/estop ({"engaged": true|false}), POST /api/estop/all, and
+POST /login/estop (the sign-in page's engage-only button)."""
 
 from __future__ import annotations
 
-from flask import Blueprint, jsonify, request
+from flask import Blueprint, abort, jsonify, make_response, render_template, request
 
 from rover_web.auth import require_role, signed_in_name
-from rover_web.core.state import current_feature
-from rover_web.web.http import ApiError, error_response, json_body
+from rover_web.core.state import current_feature, current_rover
+from rover_web.web.http import ApiError, accepts_form, error_response, json_body, too_many
 from rover_web.web.validate import InvalidInput, only_keys, text
 
 from .fleet import FleetEStop
@@ -44,14 +45,63 @@ def estop_state():
 
 @bp.post("/api/estop/all")
 def estop_all():
-    """Engage every robot's e-stop (the "Stop all" button); releasing stays one robot at a time."""
+    """Engage every robot's e-stop (the "Stop all" button); releasing stays one robot at a time.
+
+    Takes the body POST /api/estop engages with, `{"engaged": true}`, and an empty one; a release
+    here is refused: releasing every robot at once would let robots move whose surroundings
+    nobody looked at.
+    """
     body = json_body(required=False)
+    if body.get("engaged") is True:  # as POST /api/estop: engaging works whatever else the body says
+        return _engage_all(client_name(body.get("by")))
     try:
-        only_keys(body, {"by"})
+        only_keys(body, {"engaged", "by"})
+        engaged = body.get("engaged", True)
+        if engaged is False:
+            raise ApiError(400, "release_per_robot", "releasing is per robot: POST {\"engaged\": false} to "
+                           "/robots/<name>/api/estop (or /api/estop with one robot); this route only engages")
+        if engaged is not True:
+            raise InvalidInput("'engaged' must be true (this route only engages)", "bad_type")
         by = text(body, "by", max_len=NAME_MAX_LEN, default=None)
     except InvalidInput as exc:
         raise ApiError(400, exc.code, str(exc)) from None
-    robots = current_feature(FleetEStop).engage_all(client_name(by))
+    return _engage_all(client_name(by))
+
+
+@bp.post("/login/estop")
+@accepts_form
+def login_estop():
+    """The sign-in page's e-stop: engages every robot, for anyone who can reach the page, signed in
+    or not (docs/security.md#the-sign-in-pages-e-stop). It never releases, and takes no input but
+    the request itself: who is the client's address. Limited per address (each engage stores the
+    latch with an fsync); the Host and Origin guard applies as to every POST."""
+    if not current_rover().config["ROVER_WEB_LOGIN_ESTOP"]:
+        abort(404)
+    address = request.remote_addr or "unknown"
+    wait_s = current_feature(FleetEStop).public_engages.hit(address)
+    as_json = request.mimetype == "application/json"
+    if wait_s > 0:
+        if as_json:
+            raise too_many("e-stop engages from the sign-in page", wait_s)
+        return _login_page(429, f"too many e-stop engages from this address: try again in {wait_s:.0f} s",
+                           retry_after_s=wait_s)
+    response = _engage_all(f"sign-in page ({address})"[:NAME_MAX_LEN])
+    if as_json:
+        return response
+    return _login_page(200, "E-stop engaged on every robot. Releasing it needs an operator to sign in.")
+
+
+def _login_page(status: int, notice: str, retry_after_s: float | None = None):
+    html = render_template("login.html", next=request.script_root + "/", error=None, username="", login_estop=True,
+                           estop_notice=notice)
+    response = make_response(html, status, {"Content-Type": "text/html; charset=utf-8"})
+    if retry_after_s is not None:
+        response.headers["Retry-After"] = str(max(1, int(retry_after_s + 0.999)))
+    return response
+
+
+def _engage_all(by: str):
+    robots = current_feature(FleetEStop).engage_all(by)
     return jsonify({"engaged": all(state["engaged"] for state in robots.values()), "robots": robots})
 
 

@@ -2,8 +2,8 @@
 
 HTTP (routes.py):
   GET /api/geofence    the fence, a GeoJSON FeatureCollection (plus its `revision`)
-  PUT /api/geofence    replace it whole (operator); invalid GeoJSON, self-intersecting rings, too many
-                       vertices or the antimeridian -> 400, nothing changed
+  PUT /api/geofence    replace it whole (admin; an operator-log line names who); invalid GeoJSON,
+                       self-intersecting rings, too many vertices or the antimeridian -> 400, nothing changed
 SSE: `geofence`, the robot's side of the fence (inside, outside, unknown) and the fence's revision.
 Other features call `check_point` / `check_route` (rules.OutsideGeofence, answered 422) before they
 store or publish a waypoint or send a mission. The /fix callback (waypoints) hands positions to
@@ -19,6 +19,7 @@ from rover_web.config import ROOT, ConfigError
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover, current_feature
 from rover_web.estop import EStopService
+from rover_web.panels.oplog import OperatorLog
 
 from . import routes
 from .routes import outside_geofence_response
@@ -42,7 +43,8 @@ def _init_robot(rover: Rover) -> None:
     config = rover.config
     service = GeofenceService(GeofenceStore(rover.db), rover.feature(EStopService), rover.hub,
                               max_vertices=config["ROVER_WEB_GEOFENCE_MAX_VERTICES"],
-                              engage_estop=config["ROVER_WEB_GEOFENCE_ESTOP"])
+                              engage_estop=config["ROVER_WEB_GEOFENCE_ESTOP"],
+                              oplog=OperatorLog(rover.db, config["ROVER_WEB_PANELS_LOG_KEEP"]))
     rover.hub.register(CHANNEL)
     if config["ROVER_WEB_GEOFENCE_FILE"]:
         service.seed(_read_file(config["ROVER_WEB_GEOFENCE_FILE"], service.max_vertices))

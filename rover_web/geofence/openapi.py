@@ -16,7 +16,7 @@ PATHS = {
     "/api/geofence": {
         "get": op("The enforced geofence, as a GeoJSON FeatureCollection", tag="geofence", ok=COLLECTION),
         "put": op("Replace the geofence (keep_in and keep_out Polygons and MultiPolygons)", tag="geofence",
-                  role="operator", body=COLLECTION, ok=COLLECTION,
+                  role="admin", body=COLLECTION, ok=COLLECTION,
                   errors={400: "bad_json, bad_geojson, bad_type, invalid_geometry, out_of_range "
                                "(self-intersecting rings, too many vertices, across the antimeridian)",
                           503: "storage_unavailable", 507: "disk_full"}),

@@ -7,6 +7,7 @@ import threading
 import time
 
 from rover_web.estop import EStopService
+from rover_web.panels.oplog import OperatorLog
 
 from .rules import Fence, parse_fence
 from .store import GeofenceStore
@@ -15,12 +16,14 @@ log = logging.getLogger(__name__)
 
 CHANNEL = "geofence"
 ESTOP_BY = "geofence breach"
+OPLOG_PANEL = "geofence"  # its entries in the operator log (panel_log)
 
 
 class GeofenceService:
     def __init__(self, store: GeofenceStore, estop: EStopService, hub, *, max_vertices: int,
-                 engage_estop: bool):
+                 engage_estop: bool, oplog: OperatorLog | None = None):
         self.store = store
+        self.oplog = oplog
         self.estop = estop
         self.hub = hub
         self.max_vertices = max_vertices
@@ -42,13 +45,19 @@ class GeofenceService:
     def collection(self) -> dict:
         return {**self.fence.to_geojson(), "revision": self.revision}
 
-    def replace(self, doc) -> dict:
-        """Check and store a new fence; InvalidInput (nothing changed) when it is not one."""
+    def replace(self, doc, by: str = "") -> dict:
+        """Check and store a new fence; InvalidInput (nothing changed) when it is not one. Who did
+        it goes in the operator log (panel "geofence")."""
         fence = parse_fence(doc, self.max_vertices)
         with self._write_lock:
             revision = self.store.save(fence.to_geojson())
             self.fence, self.revision = fence, revision
-        log.info("geofence replaced: revision %d, %d areas", revision, len(fence.areas))
+        log.info("geofence replaced by %s: revision %d, %d areas", by or "?", revision, len(fence.areas))
+        if self.oplog is not None:
+            action = "empty" if fence.empty else "replace"
+            done = "emptied" if fence.empty else "replaced"
+            self.oplog.record(OPLOG_PANEL, action, f"geofence {done}: revision {revision}, {len(fence.areas)} areas",
+                              None, "sent", client=by)
         self.pending.set()  # the robot may be outside the new fence
         self._publish()
         return self.collection()
@@ -56,7 +65,7 @@ class GeofenceService:
     def seed(self, doc) -> None:
         """The default fence (ROVER_WEB_GEOFENCE_FILE) when none was ever stored."""
         if self.revision == 0:
-            self.replace(doc)
+            self.replace(doc, by="ROVER_WEB_GEOFENCE_FILE")
 
     # --- checks other features make before anything is stored or published ---
 

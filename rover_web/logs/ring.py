@@ -1,7 +1,8 @@
 """The /rosout ring: the last N log lines, queried with filters, repeats grouped. Pure Python.
 
-Bounded by construction (a deque with maxlen), so a node that logs 1,000 lines a second costs a
-fixed amount of memory. Lines received since the last `drain()` wait in a second bounded list for
+Bounded twice: at most `keep` lines, and at most `max_bytes` of their text (msgs.py cuts each
+field on arrival, so one line is at most a few kilobytes), so a node that logs 1,000 long lines a
+second costs a fixed amount of memory. Lines received since the last `drain()` wait in a second bounded list for
 the `rosout` channel, so the browser gets a few batches a second instead of one event per line.
 """
 
@@ -14,6 +15,12 @@ from collections import deque
 LEVELS = {"DEBUG": 10, "INFO": 20, "WARN": 30, "ERROR": 40, "FATAL": 50}
 NAMES = {v: k for k, v in LEVELS.items()}
 ERROR_WINDOW_S = 60.0
+LINE_OVERHEAD_BYTES = 200  # a line's dict, its numbers and keys, besides its text
+
+
+def line_bytes(line: dict) -> int:
+    """What a line costs the ring, roughly: its text and a fixed overhead."""
+    return LINE_OVERHEAD_BYTES + sum(len(line[k]) for k in ("msg", "node", "file", "function"))
 
 
 def level_name(level: int) -> str:
@@ -37,9 +44,12 @@ def same_line(a: dict, b: dict) -> bool:
 
 
 class LogRing:
-    def __init__(self, keep: int, batch_max: int = 250, clock=time.monotonic):
+    def __init__(self, keep: int, batch_max: int = 250, clock=time.monotonic, max_bytes: int = 16 << 20):
         self.keep = keep
-        self._lines: deque[dict] = deque(maxlen=keep)
+        self.max_bytes = max_bytes
+        self._lines: deque[dict] = deque()
+        self._costs: deque[int] = deque()  # line_bytes of each line in _lines
+        self.bytes = 0
         self._errors: deque[float] = deque(maxlen=keep)  # receive times of ERROR and FATAL lines
         self._pending: list[dict] = []
         self._batch_max = batch_max
@@ -53,7 +63,14 @@ class LogRing:
         with self._lock:
             self._seq += 1
             line["seq"] = self._seq
+            cost = line_bytes(line)
             self._lines.append(line)
+            self._costs.append(cost)
+            self.bytes += cost
+            # The newest line always stays, whatever it costs; older ones go until both bounds hold.
+            while len(self._lines) > 1 and (len(self._lines) > self.keep or self.bytes > self.max_bytes):
+                self._lines.popleft()
+                self.bytes -= self._costs.popleft()
             if line["level"] >= LEVELS["ERROR"]:
                 self._errors.append(self._clock())
             if len(self._pending) < self._batch_max:

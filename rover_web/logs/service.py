@@ -14,7 +14,8 @@ HEALTH_PERIOD_S = 1.0
 class RosoutLog:
     def __init__(self, rover: Rover):
         self.rover = rover
-        self.ring = LogRing(rover.config["ROVER_WEB_ROSOUT_KEEP"])
+        config = rover.config
+        self.ring = LogRing(config["ROVER_WEB_ROSOUT_KEEP"], max_bytes=config["ROVER_WEB_ROSOUT_KEEP_BYTES"])
         self.received = 0
         self._health: dict | None = None
 

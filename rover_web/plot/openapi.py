@@ -5,7 +5,8 @@ from rover_web.apidocs.describe import obj, op, page, query
 TOPIC = query("topic", {"type": "string", "minLength": 1}, "the topic", required=True)
 TYPE = query("type", {"type": "string"}, "pkg/msg/Name, when the topic is not up yet or carries several")
 REFUSED = {400: "missing_field, bad_topic, bad_type, type_mismatch, ambiguous_type, unknown_type",
-           404: "unknown_topic", 503: "too_many_subscriptions, too_many_series, shutting_down"}
+           404: "unknown_topic", 422: "not_plottable (images, point clouds, maps)",
+           503: "too_many_subscriptions, too_many_series, shutting_down"}
 
 PATHS = {
     "/plot": {"get": page("Live plots of numeric fields", tag="pages")},

@@ -15,7 +15,7 @@ from rover_web.web.validate import InvalidInput
 
 from . import msgs
 from .field import FieldError
-from .service import Plots, TooManySeries, series_id
+from .service import NotPlottable, Plots, TooManySeries, check_plottable, oversize, series_id
 
 bp = Blueprint("plot", __name__)
 
@@ -61,6 +61,8 @@ def api_plot():
     plots = current_feature(Plots)
     try:
         series = plots.series(key, field)
+    except NotPlottable as exc:
+        raise ApiError(422, "not_plottable", str(exc)) from None
     except FieldError as exc:
         raise ApiError(400, exc.code, str(exc)) from None
     except TooManySeries as exc:
@@ -70,12 +72,17 @@ def api_plot():
     t, v, decimated = series.ring.window(time.time() - seconds)
     return jsonify({"id": series_id(key[0], field), "topic": key[0], "type": key[1], "field": field,
                     "seconds": seconds, "t": t, "v": v, "decimated": decimated,
-                    "skipped_nonfinite": series.ring.skipped_nonfinite, "idle_s": plots.idle_s})
+                    "skipped_nonfinite": series.ring.skipped_nonfinite, "skipped_oversize": oversize(plots, key),
+                    "idle_s": plots.idle_s})
 
 
 @bp.get("/api/plot/fields")
 def api_plot_fields():
     topic, type_name = _topic_key(request.args)
+    try:
+        check_plottable(type_name)
+    except NotPlottable as exc:
+        raise ApiError(422, "not_plottable", str(exc)) from None
     return jsonify({"topic": topic, "type": type_name, "fields": msgs.numeric_paths(type_name)})
 
 

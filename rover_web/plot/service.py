@@ -24,11 +24,24 @@ log = logging.getLogger(__name__)
 
 TICK_S = 0.1  # new points go to browsers at most 10 times a second
 RAW_QUEUE = 5000  # messages waiting for the plot loop per topic (a 1 kHz topic over a slow tick)
+RAW_QUEUE_BYTES = 8 << 20  # ... and at most this many of their bytes (oldest dropped)
 MAX_SERIES = 64
+# Bulk data, not numbers to plot: a 6 MB image decoded ten times a second for one field of its
+# header was the cost (issue 27). Refused by type; any other message over
+# ROVER_WEB_PLOT_MAX_MESSAGE_BYTES is dropped unread in the subscription callback.
+NOT_PLOTTABLE = frozenset({
+    "sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage", "sensor_msgs/msg/PointCloud2",
+    "sensor_msgs/msg/PointCloud", "nav_msgs/msg/OccupancyGrid", "map_msgs/msg/OccupancyGridUpdate",
+    "theora_image_transport/msg/Packet", "ffmpeg_image_transport_msgs/msg/FFMPEGPacket",
+})
 
 
 class TooManySeries(RuntimeError):
     pass
+
+
+class NotPlottable(ValueError):
+    """A type whose messages are bulk data (images, point clouds, maps): refused before subscribing."""
 
 
 class _Series:
@@ -42,15 +55,45 @@ class _Series:
 class _PlotTopic:
     """One subscribed topic: its raw message queue and the series read from it."""
 
-    def __init__(self, key: tuple[str, str], echo):
+    def __init__(self, key: tuple[str, str], echo, max_message_bytes: int):
         self.key = key
         self.echo = echo
         self.decode = msgs.deserializer(key[1])
-        self.raw: deque[tuple[float, bytes]] = deque(maxlen=RAW_QUEUE)
+        self.max_message_bytes = max_message_bytes
+        self.raw: deque[tuple[float, bytes]] = deque()
+        self.raw_bytes = 0
+        self.oversize = 0  # messages dropped unread for their size
+        self._raw_lock = threading.Lock()
         self.series: dict[str, _Series] = {}
 
     def put(self, serialized: bytes) -> None:
-        self.raw.append((time.time(), serialized))  # from the ROS callback: no decoding here
+        """From the ROS callback: no decoding here, and nothing kept of a message over the size cap."""
+        size = len(serialized)
+        if size > self.max_message_bytes:
+            self.oversize += 1
+            return
+        with self._raw_lock:
+            self.raw.append((time.time(), serialized))
+            self.raw_bytes += size
+            while len(self.raw) > RAW_QUEUE or self.raw_bytes > RAW_QUEUE_BYTES:
+                self.raw_bytes -= len(self.raw.popleft()[1])
+
+    def take(self) -> list[tuple[float, bytes]]:
+        with self._raw_lock:
+            batch, self.raw, self.raw_bytes = list(self.raw), deque(), 0
+        return batch
+
+
+def check_plottable(type_name: str) -> None:
+    if type_name in NOT_PLOTTABLE:
+        raise NotPlottable(f"{type_name} is bulk data (images, point clouds, maps), not numbers to plot; "
+                           "plot a topic of numbers, or view it in the camera or topic pages")
+
+
+def oversize(plots: Plots, key: tuple[str, str]) -> int:
+    """Messages of a plotted topic dropped unread for their size (0 when it is not plotted)."""
+    plot_topic = plots._topics.get(key)
+    return plot_topic.oversize if plot_topic is not None else 0
 
 
 def series_id(topic: str, field: str) -> str:
@@ -62,6 +105,7 @@ class Plots:
         self.rover = rover
         self.keep = rover.config["ROVER_WEB_PLOT_KEEP_POINTS"]
         self.idle_s = rover.config["ROVER_WEB_PLOT_IDLE_S"]
+        self.max_message_bytes = rover.config["ROVER_WEB_PLOT_MAX_MESSAGE_BYTES"]
         self._topics: dict[tuple[str, str], _PlotTopic] = {}
         self._lock = threading.Lock()
         self.decode_errors = 0
@@ -74,9 +118,10 @@ class Plots:
     def series(self, key: tuple[str, str], field: str) -> _Series:
         """The series of `field` on topic `key` (topic, type), started now if new.
 
-        FieldError when the type has no number there; the topic browser's EchoRefused when its
-        subscription cannot be had (caps, shutdown).
+        NotPlottable for a type of bulk data; FieldError when the type has no number there; the
+        topic browser's EchoRefused when its subscription cannot be had (caps, shutdown).
         """
+        check_plottable(key[1])
         steps = parse_path(field)
         msgs.numeric_kind(key[1], steps)
         with self._lock:
@@ -89,7 +134,7 @@ class Plots:
                 raise TooManySeries(f"{MAX_SERIES} series are plotted already")
             if plot_topic is None:
                 echo = self.browser.acquire(key)
-                plot_topic = self._topics[key] = _PlotTopic(key, echo)
+                plot_topic = self._topics[key] = _PlotTopic(key, echo, self.max_message_bytes)
                 echo.listeners = (*echo.listeners, plot_topic.put)
             series = plot_topic.series[field] = _Series(field, self.keep)
             self.plotting.set()
@@ -102,9 +147,7 @@ class Plots:
         with self._lock:
             topics = list(self._topics.values())
         for plot_topic in topics:
-            batch = []
-            while plot_topic.raw:
-                batch.append(plot_topic.raw.popleft())
+            batch = plot_topic.take()
             if batch:
                 self._decode(plot_topic, batch, fresh)
         if fresh:
@@ -169,4 +212,4 @@ class Plots:
                 log.exception("releasing the plot subscription of %s failed", key[0])
 
 
-__all__ = ["FieldError", "Plots", "TooManySeries", "series_id"]
+__all__ = ["FieldError", "NotPlottable", "Plots", "TooManySeries", "check_plottable", "oversize", "series_id"]

@@ -2,12 +2,18 @@
 
 Each feature owns its tables and creates them with `ensure_schema`. Connections are per thread
 (sqlite3 objects must not cross threads); a write is committed before the request is answered.
+
+The file holds password hashes: a folder rover_web makes for it is 0700, and the file is created
+0600 before SQLite opens it. SQLite gives the `-wal` and `-shm` files it makes beside it the
+database file's own mode, so they are 0600 too (without this, all three were 0644).
 """
 
 from __future__ import annotations
 
+import logging
 import os
 import sqlite3
+import stat
 import threading
 import weakref
 from collections.abc import Iterator
@@ -18,12 +24,14 @@ from flask import Flask
 
 from rover_web.config import ConfigError
 
+log = logging.getLogger(__name__)
+
 
 def database_path(app: Flask) -> Path:
     configured = app.config.get("ROVER_WEB_DB_PATH")
     path = Path(configured) if configured else Path(app.instance_path) / "rover_web.sqlite3"
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
+        path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)  # the mode only if made here
     except OSError as exc:
         raise ConfigError(f"cannot use the database {path}: its folder cannot be made ({exc.strerror}); "
                           f"set ROVER_WEB_DB_PATH to a file in a writable folder") from None
@@ -46,10 +54,30 @@ class Database:
         self._all: set[sqlite3.Connection] = set()
         self._lock = threading.Lock()
         self._write_lock = threading.RLock()
+        self._created = False
+
+    def _create_private(self) -> None:
+        """Make the file, empty and 0600, if it does not exist (SQLite takes an empty file as a new
+        database); an existing one keeps its mode, with a warning if others may read it."""
+        try:
+            fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        except FileExistsError:
+            mode = stat.S_IMODE(os.stat(self.path).st_mode)
+            if mode & 0o077:
+                log.warning("the database %s (password hashes) may be read by others (mode %o): chmod 600 it",
+                            self.path, mode)
+            return
+        except OSError:
+            return  # a folder that cannot be written: SQLite's own error says so, with its hint (check)
+        os.close(fd)
 
     def connection(self) -> sqlite3.Connection:
         holder = getattr(self._local, "holder", None)
         if holder is None:
+            with self._lock:
+                if not self._created:
+                    self._create_private()
+                    self._created = True
             conn = sqlite3.connect(self.path, timeout=10.0, isolation_level=None, check_same_thread=False)
             conn.row_factory = sqlite3.Row
             conn.execute("PRAGMA journal_mode=WAL")

@@ -101,3 +101,21 @@ def test_the_whole_dashboard_over_https_with_a_self_signed_certificate(server_pr
     finally:
         context.close()
 
+
+
+def test_anyone_on_the_sign_in_page_can_engage_the_e_stop_but_not_release_it(signed_server, page):
+    import requests
+
+    viewer = {"Authorization": f"Bearer {signed_server.tokens['viewer']}"}
+    page.goto(signed_server.url + "/")
+    page.wait_for_url("**/login?next=/**", wait_until="commit")
+    page.click("#login-estop")
+    page.wait_for_selector(".login-estop-notice")
+    assert "E-stop engaged on every robot" in page.locator(".login-estop-notice").inner_text()
+    state = requests.get(signed_server.url + "/api/estop", headers=viewer, timeout=5).json()
+    assert state["engaged"] is True and state["by"].startswith("sign-in page")
+    # The page still signs in; only an operator's Release lets the robot move again.
+    page.fill("input[name=username]", "operator")
+    page.fill("input[name=password]", PASSWORD)
+    page.click("form.login button[type=submit]")
+    page.wait_for_selector("#estop[data-engaged='yes']", timeout=10000)

@@ -14,6 +14,7 @@ ROLES = ("viewer", "operator", "admin")
 def add_users(db_path: str | Path, *roles: str) -> dict[str, str]:
     """One user per role, named after it; returns {role: API token}."""
     db = Database(db_path)
+    accounts = None
     try:
         accounts = Accounts(db)
         tokens = {}
@@ -22,6 +23,8 @@ def add_users(db_path: str | Path, *roles: str) -> dict[str, str]:
             tokens[role] = accounts.create_token(role, "tests")[1]
         return tokens
     finally:
+        if accounts is not None:
+            accounts.gate.close()  # its hashing threads
         db.close()
 
 

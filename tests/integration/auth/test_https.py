@@ -96,3 +96,8 @@ def test_plain_http_to_the_https_port_is_refused_without_harm(https_server):
         requests.get(f"http://127.0.0.1:{https_server.port}/api/status", timeout=5)
     assert requests.get(https_server.url + "/login", verify=str(https_server.cert), timeout=5).status_code == 200
 
+
+def test_hsts_is_sent_over_tls(https_server):
+    page = requests.get(https_server.url + "/login", verify=str(https_server.cert), timeout=5)
+    assert page.headers["Strict-Transport-Security"] == "max-age=31536000"
+

@@ -22,7 +22,7 @@ REQUESTS = [
     ("POST", "/api/panels/drone/unlock", {}, "operator", "/api/panels/<panel_id>/unlock"),
     ("POST", "/api/panels/drone/stop", {}, "operator", "/api/panels/<panel_id>/<control_id>"),
     ("POST", "/api/panels/drone/lock", {}, "operator", "/api/panels/<panel_id>/lock"),
-    ("PUT", "/api/geofence", {"type": "FeatureCollection", "features": []}, "operator", "/api/geofence"),
+    ("PUT", "/api/geofence", {"type": "FeatureCollection", "features": []}, "admin", "/api/geofence"),
     ("POST", "/waypoints", {"lng": -71.0, "lat": 42.0}, "operator", "/waypoints"),
     ("POST", "/api/waypoints", {"lng": -71.001, "lat": 42.001}, "operator", "/api/waypoints"),
     ("PATCH", "/api/waypoints/{waypoint}", {"label": "dock"}, "operator", "/api/waypoints/<int:waypoint_id>"),
@@ -53,7 +53,7 @@ ANSWERED_WITHOUT_A_PEER = {
     "/api/actions/<goal_id>/cancel": (404, "unknown_goal"),
 }
 RANK = {None: -1, "viewer": 0, "operator": 1, "admin": 2}
-PUBLIC = {("POST", "/login")}
+PUBLIC = {("POST", "/login"), ("POST", "/login/estop")}  # tests/integration/estop/test_estop_all.py
 
 
 def test_the_table_names_every_state_changing_route(app):

@@ -166,3 +166,40 @@ def test_the_demo_fence_is_valid_and_holds_the_simulator_start():
     fence = parse_fence(json.loads((ROOT / DEMO_GEOFENCE).read_text()), 2000)
     assert fence.allows(BENDERSON_LON, BENDERSON_LAT)
     assert not fence.allows(BENDERSON_LON + 0.02, BENDERSON_LAT)
+
+
+def test_only_an_admin_replaces_or_empties_the_fence_and_the_operator_log_names_them(app_factory, tmp_path):
+    """Issue 27: any operator could empty the fence (and with it every keep-out check), logged without a name."""
+    from tests.support.auth import add_users
+
+    db_path = tmp_path / "signed.sqlite3"
+    tokens = add_users(db_path)
+    app = app_factory(ROVER_WEB_AUTH="required", ROVER_WEB_DB_PATH=str(db_path),
+                      ROVER_WEB_MAP_TILES=str(tmp_path / "no-tiles"), ROVER_WEB_GEOFENCE_MAX_VERTICES=40)
+    client = app.test_client()
+    as_ = {role: {"Authorization": f"Bearer {token}"} for role, token in tokens.items()}
+    assert client.put("/api/geofence", json=FENCE, headers=as_["admin"]).status_code == 200
+    empty = {"type": "FeatureCollection", "features": []}
+    for role in ("viewer", "operator"):
+        refused = client.put("/api/geofence", json=empty, headers=as_[role])
+        assert refused.status_code == 403 and refused.get_json()["error"] == "forbidden", role
+    assert stored_fence(app)[1] == 1  # unchanged
+    assert client.put("/api/geofence", json=empty, headers=as_["admin"]).get_json()["revision"] == 2
+    conn = sqlite3.connect(db_path)
+    try:
+        rows = conn.execute("SELECT control, label, client FROM panel_log WHERE panel = 'geofence' "
+                            "ORDER BY id").fetchall()
+    finally:
+        conn.close()
+    assert [(r[0], r[2]) for r in rows] == [("replace", "admin"), ("empty", "admin")]
+    assert "revision 2, 0 areas" in rows[1][1]
+
+
+def test_with_sign_in_off_the_operator_log_names_the_address(gf_app):
+    client = gf_app.test_client()
+    assert client.put("/api/geofence", json=FENCE).status_code == 200
+    conn = sqlite3.connect(gf_app.config["ROVER_WEB_DB_PATH"])
+    try:
+        assert conn.execute("SELECT client FROM panel_log WHERE panel = 'geofence'").fetchall() == [("127.0.0.1",)]
+    finally:
+        conn.close()

@@ -80,3 +80,14 @@ def test_the_logs_page_renders_with_the_lines_in_it(live_server, ros_peer):
     wait_until(lambda: rosout(live_server, node="page_node").json()["lines"], 15, "line served")
     page = requests.get(live_server.url + "/logs", timeout=5).text
     assert "visible on the page" in page and "page_node" in page
+
+
+def test_a_huge_line_from_another_node_is_kept_cut(live_server, ros_peer):
+    """Issue 27: lines were kept whole (5,000 one-megabyte lines, 5 GB)."""
+    peer = ros_peer("verbose_node")
+    peer.log("start " + "z" * 200_000 + " end", "error")
+    wait_until(lambda: rosout(live_server, node="verbose_node").json()["lines"], 15, "the line served")
+    line = rosout(live_server, node="verbose_node").json()["lines"][0]
+    assert line["msg"].startswith("start zzz") and line["msg"].endswith("more characters cut]")
+    assert len(line["msg"]) < 4100 and " end" not in line["msg"]
+    assert live_server.rover.feature(RosoutLog).ring.bytes < 100_000  # the whole ring, less than the line was

@@ -116,3 +116,34 @@ def test_plots_and_echoes_share_one_subscription_and_the_topic_browsers_cap(live
     refused = plot(server, topic="/test/other", field="twist.twist.linear.x")
     assert refused.status_code == 503 and refused.json()["error"] == "too_many_streams"
     assert ("/test/other", ODOM) not in echoes
+
+
+def test_an_image_topic_is_refused_before_any_subscription(live_server, ros_peer):
+    """Issue 27: plotting height of a camera decoded every 6 MB frame; now refused by type with a 422."""
+    peer = ros_peer("camera_peer")
+    peer.advertise("/test/image", "sensor_msgs/msg/Image")
+    wait_until(lambda: listed(live_server, "/test/image"), 15, "topic listed")
+    peer.publish("/test/image", {"height": 480, "width": 640, "encoding": "rgb8", "step": 1920,
+                                 "data": [0] * (640 * 3 * 4)})
+    for path in ("/api/plot", "/api/plot/fields"):
+        refused = requests.get(live_server.url + path, params={"topic": "/test/image", "field": "height"}, timeout=5)
+        assert refused.status_code == 422 and refused.json()["error"] == "not_plottable", path
+    assert len(live_server.rover.feature(TopicBrowser).echoes) == 0  # nothing was subscribed
+    assert live_server.rover.feature(Plots).active() == []
+
+
+def test_messages_over_the_size_cap_are_dropped_unread(live_server_factory, ros_peer):
+    server = live_server_factory(ROVER_WEB_PLOT_MAX_MESSAGE_BYTES=4096)
+    peer = ros_peer("array_peer")
+    peer.advertise("/test/array", "std_msgs/msg/Float64MultiArray")
+    wait_until(lambda: listed(server, "/test/array"), 15, "topic listed")
+    assert plot(server, topic="/test/array", field="data[0]").status_code == 200
+    peer.wait_match("/test/array")
+    for i in range(3):
+        peer.publish("/test/array", {"data": [float(i)] * 2000})  # 16 kB: over the cap
+    peer.publish("/test/array", {"data": [7.0, 8.0]})  # small: plotted
+    reply = wait_until(lambda: (r := plot(server, topic="/test/array", field="data[0]").json())["v"] and r, 10,
+                       "the small message plotted")
+    assert reply["v"] == [7.0]
+    wait_until(lambda: plot(server, topic="/test/array", field="data[0]").json()["skipped_oversize"] == 3, 10,
+               "three big messages dropped")

@@ -3,8 +3,10 @@
 import sqlite3
 
 import pytest
+from argon2 import PasswordHasher
 
-from rover_web.auth.accounts import AccountError, Accounts, User, token_digest
+from rover_web.auth.accounts import AccountError, Accounts, User, password_hasher, token_digest
+from rover_web.auth.throttle import HashGate, HashingBusy
 from rover_web.storage.db import Database
 
 
@@ -17,7 +19,9 @@ def db(tmp_path):
 
 @pytest.fixture
 def accounts(db):
-    return Accounts(db)
+    made = Accounts(db)
+    yield made
+    made.gate.close()
 
 
 def test_a_user_signs_in_with_their_password_only(accounts):
@@ -118,3 +122,39 @@ def test_revoking_a_token_id_beyond_sqlite_integers_is_no_such_token_not_an_over
         with pytest.raises(AccountError) as refused:
             accounts.revoke_token(token_id)
         assert refused.value.code == "no_such_token"
+
+
+def test_new_hashes_use_owasps_small_computer_parameters(accounts, db):
+    accounts.add_user("ada", "viewer", "correct horse")
+    stored = db.connection().execute("SELECT password_hash FROM auth_users").fetchone()[0]
+    assert "$m=19456,t=2,p=1$" in stored
+
+
+def test_a_hash_with_the_old_parameters_still_verifies_and_is_replaced_at_sign_in(db):
+    old = Accounts(db, PasswordHasher(time_cost=3, memory_cost=65536, parallelism=4))  # argon2-cffi's default
+    old.add_user("ada", "operator", "correct horse")
+    accounts = Accounts(db, password_hasher(12288, 3))
+    assert accounts.authenticate("ada", "wrong horse!") is None
+    assert "$m=65536,t=3,p=4$" in _stored(db)  # a wrong password changes nothing
+    assert accounts.authenticate("ada", "correct horse") == User("ada", "operator")
+    assert "$m=12288,t=3,p=1$" in _stored(db)
+    assert accounts.authenticate("ada", "correct horse") == User("ada", "operator")
+    old.gate.close(), accounts.gate.close()
+
+
+def test_a_sign_in_with_every_hashing_slot_taken_is_refused_before_any_hash(db):
+    accounts = Accounts(db, gate=HashGate(1))
+    accounts.add_user("ada", "operator", "correct horse")
+    hashed = accounts.gate.hashed
+    with accounts.gate.slot():
+        with pytest.raises(HashingBusy):
+            accounts.authenticate("ada", "correct horse")
+        with pytest.raises(HashingBusy):
+            accounts.authenticate("nobody", "correct horse")  # the dummy hash takes a slot too
+    assert accounts.gate.hashed == hashed + 1  # only the test's own slot
+    assert accounts.authenticate("ada", "correct horse") == User("ada", "operator")
+    accounts.gate.close()
+
+
+def _stored(db) -> str:
+    return db.connection().execute("SELECT password_hash FROM auth_users").fetchone()[0]

@@ -2,7 +2,7 @@
 
 import pytest
 
-from rover_web.logs.ring import LEVELS, LogRing, parse_level
+from rover_web.logs.ring import LEVELS, LINE_OVERHEAD_BYTES, LogRing, line_bytes, parse_level
 
 
 def line(msg, level="INFO", node="talker", stamp=0.0):
@@ -77,3 +77,32 @@ def test_levels_by_name_or_number(text, level):
 def test_bad_levels_are_refused(text):
     with pytest.raises(ValueError):
         parse_level(text)
+
+
+def test_the_ring_keeps_at_most_its_byte_budget_of_text_and_always_the_newest_line():
+    ring = LogRing(keep=5000, max_bytes=100_000)
+    for i in range(1000):
+        ring.add(line(f"{i:04d} " + "x" * 4000))
+    assert ring.bytes <= 100_000
+    assert len(ring) == 100_000 // (LINE_OVERHEAD_BYTES + 4005)
+    assert ring.query(limit=1)[0]["msg"].startswith("0999 ")
+    ring.add(line("y" * 500_000))  # a line over the whole budget (not cut): kept alone, the newest
+    assert len(ring) == 1 and ring.query(limit=1)[0]["msg"][0] == "y"
+    ring.add(line("short"))
+    assert [x["msg"] for x in ring.query()] == ["short"]
+    assert ring.bytes == LINE_OVERHEAD_BYTES + len("short") + len("talker")
+
+
+def test_each_field_of_a_log_message_is_cut_on_arrival():
+    from rcl_interfaces.msg import Log
+
+    from rover_web.logs.msgs import MAX_MSG_CHARS, MAX_NAME_CHARS, log_line
+
+    msg = Log(level=40, name="n" * 100_000, msg="m" * 1_000_000, file="f" * 100_000, function="g" * 100_000, line=7)
+    cut = log_line(msg)
+    assert cut["msg"].startswith("m" * MAX_MSG_CHARS + "… [996000 more characters cut]")
+    for key in ("node", "file", "function"):
+        assert len(cut[key]) < MAX_NAME_CHARS + 40 and cut[key].endswith("more characters cut]")
+    assert line_bytes(cut) < 6000
+    short = log_line(Log(level=20, name="talker", msg="hello", file="a.py", function="main", line=1))
+    assert (short["node"], short["msg"], short["file"], short["function"]) == ("talker", "hello", "a.py", "main")
