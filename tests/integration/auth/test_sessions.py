@@ -9,9 +9,7 @@ from datetime import timedelta
 import pytest
 
 from rover_web.config import ConfigError
-from tests.support.auth import PASSWORD, add_users, sign_in
-
-JSON = {"Accept": "application/json"}
+from tests.support.auth import add_users, sign_in
 
 
 def copy_of_cookie(client, app):
@@ -215,6 +213,3 @@ def test_sign_out_everywhere_with_sign_in_off_is_a_409(client):
     answer = client.post("/api/me/sessions/revoke", json={})
     assert answer.status_code == 409 and answer.get_json()["error"] == "sign_in_off"
 
-
-def test_a_password_still_signs_in_after_all_this(signed_app):
-    assert sign_in(signed_app.test_client(), "viewer", PASSWORD).status_code == 303
