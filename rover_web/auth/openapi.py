@@ -34,7 +34,7 @@ PATHS = {
                    tag="auth", body=obj(closed=False), body_required=False,
                    ok=obj({"user": {"type": "string"}, "signed_out_everywhere": {"type": "boolean"},
                            "streams_closed": {"type": "integer"}}),
-                   errors={409: "sign_in_off"},
+                   errors={400: "bad_json", 409: "sign_in_off"},
                    description="Renews the caller's session epoch: every session of theirs ends (this one too), "
                                "and every teleop socket, event stream, camera stream and topic echo they have "
                                "open closes, whatever it was opened with (the teleop socket stops the robot and "

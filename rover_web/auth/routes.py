@@ -249,7 +249,7 @@ def admin_update_user(name: str):
     # The change renewed the user's epoch (a trigger, sessions.py): their sessions have ended.
     own_session = current_user.via == "session" and current_user.name == name
     auth.revoked()
-    if own_session and (role is None or role == "admin"):
+    if own_session and password is not None and role in (None, "admin"):
         _start_session(auth, name)  # an admin changing their own password stays signed in here
     user = accounts.get(name)
     return jsonify(name=user.name, role=user.role)
