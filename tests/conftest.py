@@ -52,7 +52,8 @@ def app_factory(tmp_path):
 
     def make(**settings):
         config = {"TESTING": True, "ROVER_WEB_DB_PATH": str(tmp_path / f"rover_web{len(made)}.sqlite3"),
-                  "ROVER_WEB_SECRET_KEY": "tests",  # not a key file in the checkout's instance folder
+                  # 32+ bytes (a shorter key is refused), and no key file in the checkout's instance folder
+                  "ROVER_WEB_SECRET_KEY": "tests-" + "k" * 32,
                   "ROVER_WEB_HOST": "127.0.0.1"}  # where the in-process test servers listen
         config.update(settings)
         app = create_app(config)

@@ -2,13 +2,18 @@
 
   GET  /login, POST /login    the sign-in form (fields username, password; JSON works for curl)
   POST /logout                ends the session
+  POST /api/me/sessions/revoke  signs the caller out everywhere
   GET  /api/me                {"user", "role", "sign_in", "via"}
-  /api/users, /api/tokens     users and API tokens (admin)
-Sessions are Flask-Login's signed cookie (HttpOnly, SameSite=Strict, Secure over HTTPS); API tokens
-go in `Authorization: Bearer <token>`. ROVER_WEB_AUTH decides whether any of it is required.
+  /api/users, /api/tokens     users and API tokens (admin; refused while sign-in is off)
+Sessions are server-side rows (sessions.py) named by Flask-Login's signed cookie (HttpOnly,
+SameSite=Strict, Secure over HTTPS); API tokens go in `Authorization: Bearer <token>`.
+ROVER_WEB_AUTH decides whether any of it is required. Open streams and sockets end when their
+credentials do (revocation.py: `on_revoke`).
 """
 
 from __future__ import annotations
+
+from datetime import timedelta
 
 from flask import Flask, request
 from flask.sessions import SecureCookieSessionInterface
@@ -19,11 +24,13 @@ from rover_web.core.state import Rover
 
 from . import routes
 from .cli import init_cli
-from .identity import Anonymous, SignedIn, current_identity, may, signed_in_name
+from .identity import Anonymous, SignedIn, current_credential, current_identity, may, signed_in_name
+from .revocation import Credential, Registration, on_revoke
 from .routes import require_role
 from .service import AuthService, secret_key
 
-__all__ = ["init_app", "init_cli", "current_identity", "may", "require_role", "signed_in_name", "AuthService"]
+__all__ = ["init_app", "init_cli", "current_identity", "current_credential", "may", "on_revoke", "require_role",
+           "signed_in_name", "AuthService", "Credential", "Registration"]
 
 BEARER = "bearer "
 
@@ -36,12 +43,18 @@ class _SessionInterface(SecureCookieSessionInterface):
 
 
 def init_app(app: Flask, rover: Rover) -> None:
-    service = AuthService(rover.db, rover.config["ROVER_WEB_AUTH"], process.listen_hosts(rover.config), rover.config)
+    config = rover.config
+    app.secret_key = secret_key(config["ROVER_WEB_SECRET_KEY"], app.instance_path)  # before anything starts
+    service = AuthService(rover.db, config["ROVER_WEB_AUTH"], process.listen_hosts(config), config,
+                          session_hours=config["ROVER_WEB_SESSION_HOURS"],
+                          trusted_hosts=config["ROVER_WEB_TRUSTED_HOSTS"])
     service.check_startable()
     rover.add_feature(service)
     rover.on_shutdown(service.accounts.gate.close)  # the password-hashing threads
-    app.secret_key = secret_key(rover.config["ROVER_WEB_SECRET_KEY"], app.instance_path)
-    app.config.update(SESSION_COOKIE_HTTPONLY=True, SESSION_COOKIE_SAMESITE="Strict")
+    service.start(rover)
+    # The signed cookie's own age limit too (Flask's default is 31 days); the session row decides.
+    app.config.update(SESSION_COOKIE_HTTPONLY=True, SESSION_COOKIE_SAMESITE="Strict",
+                      PERMANENT_SESSION_LIFETIME=timedelta(hours=config["ROVER_WEB_SESSION_HOURS"]))
     app.session_interface = _SessionInterface()
 
     manager = LoginManager(app)
@@ -49,24 +62,26 @@ def init_app(app: Flask, rover: Rover) -> None:
     manager.session_protection = "basic"
 
     @manager.user_loader
-    def _load_user(name: str):
+    def _load_user(session_id: str):
         if "Authorization" in request.headers:
             return None  # explicit credentials win over a cookie: the token alone decides (request_loader)
-        user = service.accounts.get(name)  # each request: a removed user or a new role counts at once
-        return SignedIn(user.name, user.role, "session") if user else None
+        # Each request: a signed-out, expired or renewed session, a removed user or a new role counts at once.
+        credential = service.sessions.for_session(session_id)
+        return SignedIn(credential, session_id) if credential else None
 
     @manager.request_loader
     def _load_from_token(req):
         header = req.headers.get("Authorization", "")
         if header[: len(BEARER)].lower() != BEARER:
             return None
-        user = service.accounts.user_for_token(header[len(BEARER):].strip())
-        return SignedIn(user.name, user.role, "token") if user else None
+        credential = service.sessions.for_token(header[len(BEARER):].strip())
+        return SignedIn(credential) if credential else None
 
     app.register_blueprint(routes.bp)
 
     @app.context_processor
     def _identity_context():
         identity = current_identity()
-        return {"signed_in": identity if service.required else None, "sign_in_on": service.required,
-                "can_operate": may("operator", service.required)}
+        sign_in_on = service.sign_in_on()
+        return {"signed_in": identity if sign_in_on else None, "sign_in_on": sign_in_on,
+                "can_operate": may("operator", sign_in_on)}

@@ -5,26 +5,37 @@ from __future__ import annotations
 from flask_login import AnonymousUserMixin, UserMixin, current_user
 
 from .policy import role_allows
+from .revocation import Credential
 
 
 class SignedIn(UserMixin):
-    def __init__(self, name: str, role: str, via: str):
-        self.name = name
-        self.role = role
-        self.via = via  # "session" or "token"
+    def __init__(self, credential: Credential, session_id: str | None = None):
+        self.credential = credential  # what open streams are registered with (revocation.py)
+        self.name = credential.user
+        self.role = credential.role
+        self.via = credential.via  # "session" or "token"
+        self._session_id = session_id
 
-    def get_id(self) -> str:
-        return self.name
+    def get_id(self) -> str | None:
+        # What Flask-Login keeps in the cookie: the session's random id, never the user's name, so
+        # a cookie means nothing once its session ends (sessions.py).
+        return self._session_id
 
 
 class Anonymous(AnonymousUserMixin):
     name = None
     role = None
     via = None
+    credential = None
 
 
 def current_identity() -> SignedIn | Anonymous:
     return current_user._get_current_object()
+
+
+def current_credential() -> Credential | None:
+    """The credential the current request was let in with; None when not signed in."""
+    return current_user.credential if current_user.is_authenticated else None
 
 
 def signed_in_name() -> str | None:

@@ -6,8 +6,9 @@ Roles, each including the ones below it:
   operator  also everything that moves or commands the robot: driving (the teleop WebSocket and
             REST), taking over, releasing the e-stop, LiveMap goals, waypoint writes, the mission
             send, panel unlock and commands, canceling a goal sent from /ros.
-  admin     also users and API tokens, and /ros's writes: other nodes' parameters, service calls,
-            action goals (root over the ROS graph; docs/ros_admin.md#who-may-write).
+  admin     also users and API tokens (refused to everyone while sign-in is off: the CLI remains),
+            and /ros's writes: other nodes' parameters, service calls, action goals (root over the
+            ROS graph; docs/ros_admin.md#who-may-write).
 The default is closed: a state-changing route nobody listed needs the operator role.
 """
 
@@ -25,7 +26,7 @@ READ_METHODS = frozenset({"GET", "HEAD", "OPTIONS"})
 PUBLIC_ENDPOINTS = frozenset({"auth.login_form", "auth.login", "estop.login_estop", "static"})
 # Any signed-in user, whatever the method.
 # estop_set: the view checks release; estop_all only engages: whoever may watch may stop every robot.
-ANY_USER_ENDPOINTS = frozenset({"auth.logout", "estop.estop_set", "estop.estop_all"})
+ANY_USER_ENDPOINTS = frozenset({"auth.logout", "auth.revoke_my_sessions", "estop.estop_set", "estop.estop_all"})
 ADMIN_ENDPOINT_PREFIX = "auth.admin_"
 ADMIN_ENDPOINTS = frozenset({"ros_admin.api_set_parameter", "ros_admin.api_call_service", "ros_admin.api_send_goal"})
 
@@ -55,6 +56,34 @@ def is_loopback(host: str) -> bool:
         return ipaddress.ip_address(host).is_loopback
     except ValueError:
         return False  # a name, 0.0.0.0, :: or a unix socket: assume others can reach it
+
+
+def is_admin_endpoint(endpoint: str | None) -> bool:
+    return bool(endpoint and endpoint.startswith(ADMIN_ENDPOINT_PREFIX))
+
+
+# Headers a reverse proxy adds (RFC 7239's Forwarded, the de-facto X-Forwarded-*, nginx's X-Real-IP):
+# a request that carries one did not come from a browser on this machine, whatever address it came from.
+FORWARDING_HEADERS = ("forwarded", "x-real-ip")
+FORWARDING_PREFIX = "x-forwarded-"
+
+
+def forwarded_header(headers: Iterable[tuple[str, str]]) -> str | None:
+    """The name of the first forwarding header among `headers`, or None."""
+    for name, _value in headers:
+        lowered = name.lower()
+        if lowered in FORWARDING_HEADERS or lowered.startswith(FORWARDING_PREFIX):
+            return name
+    return None
+
+
+def exposed_host(host: str) -> str | None:
+    """The Host header's name when it is not loopback (a name others use to reach this server)."""
+    if host.startswith("["):
+        name = host[1:host.find("]")] if "]" in host else host
+    else:
+        name = host.rsplit(":", 1)[0] if host.count(":") == 1 else host
+    return None if is_loopback(name.rstrip(".")) else name
 
 
 def sign_in_required(mode: str, listen_hosts: Iterable[str]) -> bool:

@@ -1,11 +1,12 @@
-"""Sign-in pages and API (/login, /logout, /api/me), the admin API for users and tokens, and the
-check every request passes before its view runs."""
+"""Sign-in pages and API (/login, /logout, /api/me), the admin API for users and tokens, the
+check every request passes before its view runs, and the revocation hook of streamed responses."""
 
 from __future__ import annotations
 
+import socket
 from urllib.parse import unquote, urlsplit
 
-from flask import Blueprint, jsonify, make_response, redirect, render_template, request, url_for
+from flask import Blueprint, g, jsonify, make_response, redirect, render_template, request, session, url_for
 from flask_login import current_user, login_user, logout_user
 
 from rover_web.core.state import current_feature, current_rover
@@ -13,9 +14,9 @@ from rover_web.web.http import ApiError, accepts_form, error_response, json_body
 from rover_web.web.validate import InvalidInput, only_keys, text
 
 from .accounts import AccountError, HashingBusy, check_password, check_role
-from .identity import SignedIn
-from .policy import required_role, role_allows
-from .service import AuthService
+from .identity import SignedIn, current_credential
+from .policy import is_admin_endpoint, required_role, role_allows
+from .service import ADD_USER_HINT, AuthService
 
 bp = Blueprint("auth", __name__)
 
@@ -27,11 +28,23 @@ def _service() -> AuthService:
 @bp.before_app_request
 def check_access():
     auth = _service()
-    if not auth.required:
+    exposure = auth.exposure(request)
+    g.rover_web_sign_in = sign_in_on = auth.required or exposure is not None
+    if not sign_in_on:
+        if is_admin_endpoint(request.endpoint):
+            # Anyone may call anything with sign-in off; a user or token made now would still work once
+            # sign-in is turned on. Accounts are managed with the CLI until then.
+            return error_response(403, "sign_in_off",
+                                  "the users and tokens API needs sign-in on (ROVER_WEB_AUTH); until then "
+                                  "use `flask --app rover_web users ...` and `tokens ...` on the robot's computer")
         return None
     needed = required_role(request.method, request.path, request.endpoint)
     if needed is None:
         return None
+    if not current_user.is_authenticated and exposure is not None and auth.accounts.count() == 0:
+        return error_response(403, "sign_in_needed",
+                              f"sign-in is off only for requests made on this machine, and {exposure}; "
+                              f"set ROVER_WEB_AUTH=required and add a user with `{ADD_USER_HINT}`")
     if not current_user.is_authenticated:
         if request.method == "GET" and not wants_json(request):
             # With the script root: sign-in at /robots/drone/login returns to the drone's page.
@@ -52,7 +65,7 @@ def _forbidden(needed: str):
 
 def require_role(role: str) -> None:
     """For views whose rule depends on the request body (releasing the e-stop needs an operator)."""
-    if _service().required and not role_allows(current_user.role, role):
+    if _service().sign_in_on() and not role_allows(current_user.role, role):
         raise ApiError(403, "forbidden", f"this needs the {role} role; {current_user.name} is a {current_user.role}")
 
 
@@ -119,7 +132,7 @@ def login():
         auth.throttle.failed(username, address)
         return _login_refused(as_json, 401, "bad_credentials", "wrong user name or password", username, next_path)
     auth.throttle.succeeded(username, address)
-    login_user(SignedIn(user.name, user.role, "session"))
+    _start_session(auth, user.name)
     if as_json:
         return jsonify(user=user.name, role=user.role)
     return redirect(next_path, 303)
@@ -137,21 +150,82 @@ def _login_refused(as_json: bool, status: int, code: str, message: str, username
     return response
 
 
+# --- sessions ---
+
+def _start_session(auth: AuthService, user_name: str) -> None:
+    started = auth.sessions.start(user_name)
+    if started is None:  # removed between the password check and now
+        raise ApiError(401, "bad_credentials", "wrong user name or password")
+    session.clear()  # nothing of an earlier session (or of none) carries over into this one
+    login_user(SignedIn(started[1], started[0]))
+
+
 @bp.post("/logout")
 @accepts_form
 def logout():
-    logout_user()
+    auth = _service()
+    if current_user.is_authenticated and current_user.via == "session":
+        auth.sessions.end(current_user.get_id())  # a copy of the cookie is refused from now on
+        logout_user()
+        auth.revoked()  # streams and sockets opened with this session close now
+    else:
+        logout_user()
+    session.clear()
     if request.mimetype == "application/json" or request.accept_mimetypes.best == "application/json":
         return jsonify(signed_out=True)
     return redirect(url_for("auth.login_form"), 303)
 
 
+@bp.post("/api/me/sessions/revoke")
+def revoke_my_sessions():
+    """Sign out everywhere: every session of the caller (this one too) and every stream or socket
+    they have open, whatever it was opened with. API tokens stay valid."""
+    json_body(required=False)
+    auth = _service()
+    if not auth.sign_in_on():
+        raise ApiError(409, "sign_in_off", "sign-in is off: there is no session to end")
+    name = current_user.name
+    auth.sessions.end_everywhere(name)
+    logout_user()
+    session.clear()
+    closed = auth.revoked()
+    return jsonify(user=name, signed_out_everywhere=True, streams_closed=closed)
+
+
 @bp.get("/api/me")
 def me():
     auth = _service()
-    if not auth.required:
+    if not auth.sign_in_on():
         return jsonify(user=None, role="admin", sign_in=False, via=None)
     return jsonify(user=current_user.name, role=current_user.role, sign_in=True, via=current_user.via)
+
+
+@bp.after_app_request
+def end_stream_on_revocation(response):
+    """A streamed body (an event stream, a camera stream, a topic echo) goes on after its view
+    returned and its access was checked: register it, so that its socket is shut down when its
+    credential ends. The client sees the end at once; the stream's thread at its next write or
+    liveness check (at most a second). Views with a close of their own (the teleop socket, the
+    Broadcaster's streams) register with on_revoke instead, inside the view."""
+    if not response.is_streamed or request.environ.get("HTTP_UPGRADE", "").lower() == "websocket":
+        return response
+    auth = _service()
+    credential = current_credential() if auth.sign_in_on() else None
+    sock = request.environ.get("werkzeug.socket") or request.environ.get("gunicorn.socket")
+    if credential is None or sock is None:
+        return response
+    registration = auth.revocations.register(credential, lambda _reason: _cut(sock))
+    response.call_on_close(registration.cancel)
+    return response
+
+
+def _cut(sock) -> None:
+    try:
+        # socket.socket's own shutdown, also under TLS: SSLSocket.shutdown would drop its TLS state
+        # while the request thread may be writing through it.
+        socket.socket.shutdown(sock, socket.SHUT_RDWR)
+    except OSError:
+        pass  # gone already
 
 
 # --- users and tokens (admin) ---
@@ -184,7 +258,8 @@ def admin_add_user():
 @bp.patch("/api/users/<name>")
 def admin_update_user(name: str):
     body = json_body()
-    accounts = _service().accounts
+    auth = _service()
+    accounts = auth.accounts
     only_keys(body, {"role", "password"})
     if not body:
         raise InvalidInput("send 'role', 'password' or both", "missing_field")
@@ -200,13 +275,20 @@ def admin_update_user(name: str):
         accounts.set_password(name, password)
     if role is not None:
         accounts.set_role(name, role)
+    # The change renewed the user's epoch (a trigger, sessions.py): their sessions have ended.
+    own_session = current_user.via == "session" and current_user.name == name
+    auth.revoked()
+    if own_session and password is not None and role in (None, "admin"):
+        _start_session(auth, name)  # an admin changing their own password stays signed in here
     user = accounts.get(name)
     return jsonify(name=user.name, role=user.role)
 
 
 @bp.delete("/api/users/<name>")
 def admin_remove_user(name: str):
-    _service().accounts.remove_user(name)
+    auth = _service()
+    auth.accounts.remove_user(name)
+    auth.revoked()
     return jsonify(removed=name)
 
 
@@ -226,5 +308,7 @@ def admin_create_token():
 
 @bp.delete("/api/tokens/<int:token_id>")
 def admin_revoke_token(token_id: int):
-    _service().accounts.revoke_token(token_id)
+    auth = _service()
+    auth.accounts.revoke_token(token_id)
+    auth.revoked()
     return jsonify(revoked=token_id)

@@ -40,6 +40,10 @@ class _Client:
         self.last_write = time.monotonic()
         self.dead = False
 
+    def wait(self, timeout_s: float | None = None) -> bool:
+        """Until the stream has ended."""
+        return self.done.wait(timeout_s)
+
 
 class Broadcaster:
     def __init__(self, hub: EventHub, keepalive_s: float):
@@ -77,20 +81,26 @@ class Broadcaster:
         if needs_thread:
             self._wake()
 
-    def attach(self, sock: socket.socket, sub: Subscription) -> threading.Event:
-        """Serve `sock` from now on; the returned Event is set once the stream has ended."""
+    def attach(self, sock: socket.socket, sub: Subscription) -> _Client:
+        """Serve `sock` from now on; the returned stream's wait() returns once it has ended."""
         client = _Client(sock, sub)
         with self._lock:
             if self._hub.closed:
                 client.done.set()
                 sub.close()
-                return client.done
+                return client
             self._incoming.append(client)
             if self._thread is None:
                 self._thread = threading.Thread(target=self._run, name="sse-broadcaster", daemon=True)
                 self._thread.start()
         self._wake()
-        return client.done
+        return client
+
+    def end(self, client: _Client) -> None:
+        """End a stream from another thread (its user's access was revoked): the Broadcaster's
+        thread shuts its socket down at its next turn, which this call starts."""
+        client.dead = True
+        self._wake()
 
     @property
     def client_count(self) -> int:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from flask import Blueprint, jsonify, request
 
-from rover_web.auth import signed_in_name
+from rover_web.auth import on_revoke, signed_in_name
 from rover_web.core.state import current_feature, current_rover
 from rover_web.web.http import ApiError, json_body
 from rover_web.web.streams import stream_slot
@@ -46,8 +46,9 @@ def teleop_socket(ws) -> None:
         session = controller.connect(signed_in_name() or operator_name(request.args.get("name")))
         hello = {**controller.session_state(session, "connected"), "type": "hello", "session": session.id,
                  "name": session.name, **teleop.hello()}
-        TeleopSocket(ws, controller, session, teleop.max_frame_bytes).serve(
-            hello, current_rover().stopping, teleop.config["ROVER_WEB_TELEOP_WS_PING_S"] or None)
+        teleop_ws = TeleopSocket(ws, controller, session, teleop.max_frame_bytes)
+        with on_revoke(teleop_ws.revoke):  # a revoked token or session: the robot stops, then 1008
+            teleop_ws.serve(hello, current_rover().stopping, teleop.config["ROVER_WEB_TELEOP_WS_PING_S"] or None)
     finally:
         ws.thread.attach(None)  # a reader that never got a TeleopSocket ends rather than wait forever
 

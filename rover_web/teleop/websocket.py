@@ -260,6 +260,10 @@ class TeleopSocket:
             self.session.outbox.append(reply)
             self._wake.set()
 
+    def revoke(self, reason: str) -> None:
+        """Its user's credentials ended (rover_web/auth/revocation.py): stop the robot, close with 1008."""
+        self._ending(CLOSE_POLICY_VIOLATION, reason[:120])
+
     def _ending(self, code: int, reason: str) -> None:
         """Stop the robot, then have the request thread close the socket with `code`."""
         try:

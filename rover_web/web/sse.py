@@ -8,6 +8,7 @@ import time
 
 from flask import Blueprint, Response, request, stream_with_context
 
+from rover_web.auth import on_revoke
 from rover_web.core.state import current_rover
 from rover_web.events.hub import TooManyClients
 from rover_web.web.connection import peer_gone
@@ -54,7 +55,9 @@ def _serve_on_socket(rover, sock, subscription, retry: bytes) -> Response:
     except OSError:
         subscription.close()
         return Response(status=204)
-    rover.broadcaster.attach(sock, subscription).wait()
+    stream = rover.broadcaster.attach(sock, subscription)
+    with on_revoke(lambda _reason: rover.broadcaster.end(stream)):  # its user's access ended: end it
+        stream.wait()
     # The server will try to send a response on the shut-down socket and treat it as a dropped
     # connection; nothing reaches the browser.
     return Response(status=204)

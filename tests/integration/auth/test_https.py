@@ -28,6 +28,7 @@ def https_server(server_process, tmp_path):
         "ROVER_WEB_TLS_CERT": str(cert), "ROVER_WEB_TLS_KEY": str(key)},
         args=[sys.executable, "-m", "gunicorn", "-c", "gunicorn.conf.py", "rover_web:create_app()"]).start()
     server.token = tokens["operator"]
+    server.db_path = db_path
     server.cert = cert.parent / "ca.pem"  # what a client trusts
     return server
 
@@ -48,6 +49,34 @@ def open_streams(server) -> int:
     status = requests.get(server.url + "/api/status", headers={"Authorization": f"Bearer {server.token}"},
                           verify=str(server.cert), timeout=5)
     return status.json()["streams"]["open"]
+
+
+def test_a_stream_over_tls_ends_when_its_token_is_revoked_from_another_process(https_server):
+    """The streamed-body hook under gunicorn and TLS, reached by the once-a-second re-check: the
+    token is revoked in the database by this process, as `flask tokens revoke` would."""
+    from rover_web.auth.accounts import Accounts
+    from rover_web.storage.db import Database
+
+    stream = open_stream(https_server)
+    assert wait_until(lambda: open_streams(https_server) == 1, what="the stream counted")
+    db = Database(https_server.db_path)
+    try:
+        accounts = Accounts(db)
+        accounts.revoke_token(next(t["id"] for t in accounts.tokens() if t["user"] == "operator"))
+    finally:
+        db.close()
+    deadline = time.monotonic() + 10  # a bound for a loaded machine; the server aims at about a second
+    stream.settimeout(1)
+    ended = False
+    while not ended and time.monotonic() < deadline:  # status events keep coming while it lives
+        try:
+            ended = not stream.recv(65536)
+        except (ssl.SSLError, ConnectionError):
+            ended = True  # cut under the TLS layer: no close_notify
+        except TimeoutError:
+            pass
+    stream.close()
+    assert ended, "the revoked token's stream went on"
 
 
 def test_sign_in_over_https_sets_a_secure_cookie(https_server):

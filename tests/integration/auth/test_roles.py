@@ -42,6 +42,7 @@ REQUESTS = [
     ("POST", "/api/actions/goal", {"action": "/nobody", "type": "test_msgs/action/Fibonacci", "goal": {"x": 1}},
      "admin", "/api/actions/goal"),
     ("POST", "/api/actions/" + "0" * 32 + "/cancel", {}, "operator", "/api/actions/<goal_id>/cancel"),
+    ("POST", "/api/me/sessions/revoke", {}, "viewer", "/api/me/sessions/revoke"),  # tokens stay valid
     ("POST", "/logout", {}, "viewer", "/logout"),
 ]
 # Routes whose success needs a ROS peer: for a caller who may use them, this answer (from the view,

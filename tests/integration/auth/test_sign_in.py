@@ -97,7 +97,11 @@ def test_a_changed_role_counts_at_the_next_request(signed_app):
     sign_in(client, "operator")
     admin = {"Authorization": f"Bearer {signed_app.tokens['admin']}"}
     assert client.patch("/api/users/operator", json={"role": "viewer"}, headers=admin).status_code == 200
+    assert client.get("/api/me").status_code == 401  # the role change ended the session
+    sign_in(client, "operator")
     assert client.post("/api/teleop", json={"command": "forward"}).status_code == 403
+    operator_token = {"Authorization": f"Bearer {signed_app.tokens['operator']}"}
+    assert client.get("/api/me", headers=operator_token).get_json()["role"] == "viewer"  # tokens: the new role
     assert client.delete("/api/users/operator", headers=admin).status_code == 200
     assert client.get("/api/me").status_code == 401
 
@@ -135,7 +139,8 @@ def test_the_session_key_is_made_once_and_kept_private(tmp_path):
     key = secret_key(None, str(tmp_path))
     assert len(key) == 64 and secret_key(None, str(tmp_path)) == key
     assert (tmp_path / "secret_key").stat().st_mode & 0o077 == 0
-    assert secret_key("configured", str(tmp_path)) == "configured"
+    configured = "c" * 32
+    assert secret_key(configured, str(tmp_path)) == configured
 
 
 def test_a_refused_user_change_changes_nothing(signed_app):

@@ -47,3 +47,22 @@ def test_sign_in_required_by_mode_and_address():
     assert sign_in_required("auto", [])  # unknown: assume exposed
     assert sign_in_required("required", ["127.0.0.1"])
     assert not sign_in_required("off", ["0.0.0.0"])
+
+
+def test_a_proxy_s_forwarding_headers_are_recognised_whatever_their_case():
+    from rover_web.auth.policy import forwarded_header
+
+    assert forwarded_header([("Host", "127.0.0.1"), ("x-forwarded-for", "10.0.0.9")]) == "x-forwarded-for"
+    assert forwarded_header([("X-Forwarded-Proto", "https")]) == "X-Forwarded-Proto"
+    assert forwarded_header([("Forwarded", "for=10.0.0.9")]) == "Forwarded"
+    assert forwarded_header([("X-Real-IP", "10.0.0.9")]) == "X-Real-IP"
+    assert forwarded_header([("Host", "127.0.0.1"), ("Accept", "*/*")]) is None
+
+
+def test_a_host_other_than_loopback_is_exposed():
+    from rover_web.auth.policy import exposed_host
+
+    for loopback in ("127.0.0.1:5000", "localhost", "localhost:5000", "[::1]:5000", "::1", "127.0.0.2"):
+        assert exposed_host(loopback) is None, loopback
+    assert exposed_host("robot.example:443") == "robot.example"
+    assert exposed_host("192.168.1.20") == "192.168.1.20"
