@@ -46,9 +46,10 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     # before, and without, the ROS node, so `flask tiles fetch` or `flask users add` never joins
     # the ROS graph.
     from rover_web import auth, basemap, linkemu
-    from rover_web.web import http
+    from rover_web.web import dev_server, http
 
     http.init_app(app)
+    dev_server.install()  # `flask run`: no epoll descriptor left per dropped request (issue 27)
     auth.init_cli(app)
     basemap.init_cli(app)
     linkemu.init_cli(app)

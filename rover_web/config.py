@@ -109,6 +109,15 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("MAX_STREAMS", 64, "int",
             "most long-lived streams (SSE, MJPEG, topic echo, teleop sockets) at once, 503 beyond; keep it "
             "below the server's thread count so short requests such as the e-stop always find a thread", 1, 4096),
+    Setting("MAX_STREAMS_PER_CLIENT", 16, "int",
+            "most long-lived streams one user (one non-loopback address with sign-in off) may hold, 503 "
+            "beyond; teleop sockets are not counted against it", 1, 4096),
+    Setting("SUBSCRIPTIONS_PER_CLIENT", 4, "int",
+            "most different topic echoes, and apart from them most different camera encodings, one user (one "
+            "non-loopback address with sign-in off) may have open at once, 503 beyond", 1, 4096),
+    Setting("STREAMS_RESERVED", 2, "int",
+            "slots of ROVER_WEB_MAX_STREAMS only teleop sockets (and, with sign-in on, operators and admins) "
+            "may take", 0, 4096),
     # --- teleop ---
     Setting("CMD_VEL_TOPIC", "/cmd_vel", "topic", "velocity command topic"),
     Setting("CMD_VEL_STAMPED", False, "bool",

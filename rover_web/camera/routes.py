@@ -8,7 +8,7 @@ from rover_web.auth import signed_in_name
 from rover_web.core.state import current_feature
 from rover_web.web.connection import peer_gone
 from rover_web.web.http import ApiError, error_response, too_many
-from rover_web.web.streams import once, opening
+from rover_web.web.streams import once, opening, refuse_cross_site
 from rover_web.web.validate import InvalidInput
 
 from .mjpeg import MIMETYPE, OPENING, multipart_part
@@ -39,8 +39,8 @@ def stream():
     streams = current_feature(CameraStreams)
     with opening("mjpeg") as slot:
         key = streams.key_for(request.args)
-        producer = streams.acquire(key)
-    release = once(lambda: streams.release(key), slot.release)
+        producer = streams.acquire(key, slot.client)
+    release = once(lambda: streams.release(key, slot.client), slot.release)
 
     sock = request.environ.get("werkzeug.socket") or request.environ.get("gunicorn.socket")
     stopping = streams.rover.stopping
@@ -69,6 +69,7 @@ def stream():
 
 @bp.get("/snapshot")
 def snapshot():
+    refuse_cross_site()
     streams = current_feature(CameraStreams)
     wait = streams.snapshots.hit(signed_in_name() or request.remote_addr or "")
     if wait:  # each one may subscribe and decode: one client's loop must not cost everyone's frames

@@ -6,7 +6,7 @@ import logging
 import threading
 from collections.abc import Mapping
 
-from rover_web.core.leases import Closed, Full, Leases
+from rover_web.core.leases import Closed, Full, Leases, ShareUsed
 from rover_web.core.rate_limit import RateLimit
 from rover_web.core.state import Rover
 from rover_web.ros.graph import publishers_best_effort, topic_types
@@ -112,17 +112,21 @@ class CameraStreams:
             qos = "sensor_data" if publishers_best_effort(runtime, topic) else "default"
         return StreamKey(topic, msg_type, qos, parsed["width"], parsed["height"], parsed["quality"])
 
-    def acquire(self, key: StreamKey) -> FrameProducer:
+    def acquire(self, key: StreamKey, client: str | None = None) -> FrameProducer:
         with self._lock:
             if self._viewers >= self.max_viewers:
                 raise Unavailable(f"{self._viewers} camera viewers are connected already "
                                   f"(ROVER_WEB_CAMERA_MAX_VIEWERS)", "too_many_viewers")
             self._viewers += 1
         try:
-            return self.producers.acquire(key)
+            return self.producers.acquire(key, client, self._share(client))
         except Closed:
             self._viewer_left()
             raise Unavailable("the server is shutting down", "shutting_down") from None
+        except ShareUsed as exc:
+            self._viewer_left()
+            raise Unavailable(f"{exc} different camera encodings (ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT); close one first",
+                              "too_many_producers") from None
         except Full:
             self._viewer_left()
             raise Unavailable(f"{len(self.producers)} different camera streams are being encoded already "
@@ -133,9 +137,12 @@ class CameraStreams:
             log.exception("cannot subscribe to %s", key.topic)
             raise CannotSubscribe(f"cannot subscribe to {key.topic}: {exc}", "cannot_subscribe") from None
 
-    def release(self, key: StreamKey) -> None:
-        self.producers.release(key)
+    def release(self, key: StreamKey, client: str | None = None) -> None:
+        self.producers.release(key, client)
         self._viewer_left()
+
+    def _share(self, client: str | None) -> int | None:
+        return None if client is None else self.rover.config["ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT"]
 
     def _viewer_left(self) -> None:
         with self._lock:

@@ -3,6 +3,9 @@
 A camera stream or a topic echo is a ROS subscription shared by every viewer of the same thing:
 the first viewer creates it, the others reuse it, and it is closed `linger_s` after the last one
 leaves (a page reload or a quick topic switch then does not tear down and rebuild it).
+
+Users may be told apart (`client`): one client may then hold at most `share` different resources
+at once, so a single client cannot take every subscription the cap allows (issue 27).
 """
 
 from __future__ import annotations
@@ -26,13 +29,18 @@ class Full(RuntimeError):
     """`max_keys` different resources are in use: a new one would pass the cap."""
 
 
+class ShareUsed(Full):
+    """This client holds its share of different resources already; others may still open more."""
+
+
 class _Entry(Generic[T]):
-    __slots__ = ("value", "users", "idle_since")
+    __slots__ = ("value", "users", "idle_since", "clients")
 
     def __init__(self, value: T):
         self.value = value
         self.users = 0
         self.idle_since: float | None = None
+        self.clients: dict[Hashable, int] = {}  # client -> its users of this resource
 
 
 class Leases(Generic[T]):
@@ -49,21 +57,28 @@ class Leases(Generic[T]):
         self._closed = False
         self._reaper: threading.Thread | None = None
 
-    def acquire(self, key: Hashable) -> T:
+    def acquire(self, key: Hashable, client: Hashable | None = None, share: int | None = None) -> T:
         """The resource for `key`, opened now if nobody holds it; exceptions from open propagate.
-        Full when `max_keys` resources are all in use."""
+        Full when `max_keys` resources are all in use; ShareUsed when `client` already holds
+        `share` other resources (release it with the same client)."""
         evicted = None
         try:
             with self._cond:
                 if self._closed:
                     raise Closed("shutting down")
                 entry = self._entries.get(key)
+                if client is not None and share is not None and (entry is None or client not in entry.clients):
+                    held = sum(1 for e in self._entries.values() if client in e.clients)
+                    if held >= share:
+                        raise ShareUsed(f"this client holds {held} already")
                 if entry is None:
                     evicted = self._make_room()
                     # Opened under the lock so two first viewers cannot both create a subscription.
                     entry = self._entries[key] = _Entry(self._open(key))
                 entry.users += 1
                 entry.idle_since = None
+                if client is not None:
+                    entry.clients[client] = entry.clients.get(client, 0) + 1
                 return entry.value
         finally:
             if evicted is not None:  # closed outside the lock, and even when opening the new one failed
@@ -80,12 +95,16 @@ class Leases(Generic[T]):
         _, key = min(idle, key=lambda pair: pair[0])
         return key, self._entries.pop(key).value
 
-    def release(self, key: Hashable) -> None:
+    def release(self, key: Hashable, client: Hashable | None = None) -> None:
         with self._cond:
             entry = self._entries.get(key)
             if entry is None or entry.users <= 0:
                 return
             entry.users -= 1
+            if client is not None and client in entry.clients:
+                entry.clients[client] -= 1
+                if not entry.clients[client]:
+                    del entry.clients[client]
             if entry.users == 0:
                 entry.idle_since = self._clock()
                 self._cond.notify_all()  # the reaper learns of a new deadline

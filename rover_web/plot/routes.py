@@ -11,6 +11,7 @@ from rover_web.core.state import current_feature
 from rover_web.topics.routes import STATUS as ECHO_STATUS
 from rover_web.topics.service import EchoRefused, TopicBrowser
 from rover_web.web.http import ApiError
+from rover_web.web.streams import refuse_cross_site
 from rover_web.web.validate import InvalidInput
 
 from . import msgs
@@ -54,6 +55,7 @@ def _seconds(args) -> float:
 
 @bp.get("/api/plot")
 def api_plot():
+    refuse_cross_site()  # it creates a series and its subscription
     args = request.args
     field = args.get("field", "")
     seconds = _seconds(args)

@@ -56,8 +56,8 @@ def api_echo():
     rover = browser.rover
     with opening("topic_echo") as slot:
         key = browser.resolve(request.args)
-        echo = browser.acquire(key)
-    release = once(lambda: browser.release(key), slot.release)
+        echo = browser.acquire(key, slot.client)
+    release = once(lambda: browser.release(key, slot.client), slot.release)
 
     sock = request.environ.get("werkzeug.socket") or request.environ.get("gunicorn.socket")
     keepalive_s = rover.config["ROVER_WEB_SSE_KEEPALIVE_S"]

@@ -6,7 +6,7 @@ import logging
 import threading
 from collections.abc import Mapping
 
-from rover_web.core.leases import Closed, Full, Leases
+from rover_web.core.leases import Closed, Full, Leases, ShareUsed
 from rover_web.core.state import Rover
 from rover_web.ros import graph
 from rover_web.ros.typesupport import UnknownMessageType, message_class
@@ -113,16 +113,20 @@ class TopicBrowser:
             raise InvalidInput(f"{topic} carries {', '.join(known)}, not {type_name}", "type_mismatch")
         return topic, type_name
 
-    def acquire(self, key: tuple[str, str]) -> TopicEcho:
+    def acquire(self, key: tuple[str, str], client: str | None = None) -> TopicEcho:
         with self._lock:
             if self._viewers >= self.max_viewers:
                 raise Unavailable(f"{self._viewers} topic echoes are open already", "too_many_streams")
             self._viewers += 1
         try:
-            return self.echoes.acquire(key)
+            return self.echoes.acquire(key, client, self._share(client))
         except Closed:
             self._viewer_left()
             raise Unavailable("the server is shutting down", "shutting_down") from None
+        except ShareUsed as exc:
+            self._viewer_left()
+            raise Unavailable(f"{exc} different topic echoes (ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT); close one first",
+                              "too_many_subscriptions") from None
         except Full:
             self._viewer_left()
             raise Unavailable(f"{len(self.echoes)} different topics are being echoed already "
@@ -133,9 +137,12 @@ class TopicBrowser:
             log.exception("cannot subscribe to %s", key[0])
             raise CannotSubscribe(f"cannot subscribe to {key[0]}: {exc}", "cannot_subscribe") from None
 
-    def release(self, key: tuple[str, str]) -> None:
-        self.echoes.release(key)
+    def release(self, key: tuple[str, str], client: str | None = None) -> None:
+        self.echoes.release(key, client)
         self._viewer_left()
+
+    def _share(self, client: str | None) -> int | None:
+        return None if client is None else self.rover.config["ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT"]
 
     def _viewer_left(self) -> None:
         with self._lock:

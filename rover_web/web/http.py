@@ -85,11 +85,13 @@ FORM_TYPES = ("application/x-www-form-urlencoded", "multipart/form-data")
 
 # What every response may load and who may frame it. The pages load scripts, styles, images and
 # fonts from this server only; MapLibre builds its worker from a blob: URL and draws tiles from
-# blob: and data: images. Inline styles stay allowed for the templates' style="--c: ..." values.
+# blob: and data: images. No inline styles either: a page sets computed styles from its scripts
+# through the CSSOM (`el.style.x = ...`), which the policy does not restrict, so injected markup
+# can neither run nor restyle the page (e.g. hide the e-stop).
 CONTENT_SECURITY_POLICY = "; ".join([
     "default-src 'self'",
     "script-src 'self'",
-    "style-src 'self' 'unsafe-inline'",
+    "style-src 'self'",
     "img-src 'self' data: blob:",
     "worker-src 'self' blob:",
     "child-src 'self' blob:",

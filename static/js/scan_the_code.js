@@ -16,6 +16,8 @@ if (card) {
     if (colour === 'black' || colours.has(colour)) el.style.setProperty('--c', colour);
     else el.style.removeProperty('--c');
   };
+  // The server-rendered colours too: the Content-Security-Policy allows no inline style attributes.
+  for (const el of card.querySelectorAll('[data-colour]')) paint(el, el.dataset.colour);
   const problemsText = (list) => list.join(', ').replaceAll('_', ' ');
   const clock = (epochS) => new Date(epochS * 1000).toLocaleTimeString([], { hour12: false });
   const span = (cls, text) => {

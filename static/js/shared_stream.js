@@ -37,7 +37,9 @@ const DEAD_AFTER_MS = 3000;  // plus up to 1.5 s at random, so followers do not 
 const FORGET_AFTER_BEATS = 5;  // a follower that answered none of the last heartbeats is gone
 const SHRINK_AFTER_MS = 5000;
 
-// sink: { event(channel, data, id), trouble(), role('leader' | 'follower' | 'own') }.
+// sink: { event(channel, data, id), trouble(), role('leader' | 'follower' | 'own'), live() }; live():
+// whether this tab's stream is up, so a leader whose stream is down hands a joining tab nothing
+// rather than old values that would look current there.
 // Returns { restart() }, for a stream that went silent.
 export function openStream(channels, sink) {
   const mine = new Set(channels);
@@ -216,6 +218,7 @@ class SharedStream {
   }
 
   welcome(tab, channels) {
+    if (this.sink.live && !this.sink.live()) return;
     const events = [...this.latest.values()].filter((e) => channels.includes(e.channel))
       .sort((a, b) => Number(a.id) - Number(b.id));
     if (events.length) this.say({ type: 'snapshot', to: tab, events });

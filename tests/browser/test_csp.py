@@ -1,39 +1,91 @@
 """Every page under the app's Content-Security-Policy, enforced (no bypass): nothing is refused.
 
 The other browser tests bypass the policy, because Playwright's wait_for_function compiles code
-in the page; this one only navigates and waits on selectors, so the policy applies in full.
+in the page; this one only navigates and waits on selectors, so the policy applies in full. The
+policy has no 'unsafe-inline' for scripts or styles: an inline style="..." attribute in a
+template, or one written by a script as markup, is a violation here.
 """
 
 import pytest
+import requests
 
 from tests.conftest import PageWatch
 
 pytestmark = pytest.mark.browser
 
-PAGES = ["/", "/status", "/livemap", "/topics", "/panels", "/waypoints", "/logs", "/diagnostics", "/ros",
-         "/plot?topic=/odom&field=twist.twist.linear.x"]
+# Each page with what shows it is drawn (the parts that would need a style to be refused).
+PAGES = {
+    "/": ["#livemap-thumb", ".maplibregl-canvas", "#teleop-link[data-state='live']", "#link-plot canvas",
+          "#scan-the-code .stc-box"],
+    "/status": ["#link-plot canvas"],
+    "/livemap": [],
+    "/topics": [],
+    "/panels": [],
+    "/waypoints": [],
+    "/logs": [],
+    "/diagnostics": [],
+    "/ros": [],
+    "/robots": [],
+    "/plot?topic=/odom&field=twist.twist.linear.x": ["#plot-chart canvas"],
+}
+OTHER_PAGES = {"/api/docs": ".swagger-ui .info", "/login": "form"}  # no event stream on these
+
+# Collects every securitypolicyviolation event from the first script on (Playwright injects it
+# through the browser's debugging protocol, which the page's policy does not govern).
+RECORD_VIOLATIONS = """
+window.__csp = [];
+document.addEventListener('securitypolicyviolation', (e) =>
+  window.__csp.push(`${e.violatedDirective} ${e.blockedURI} ${e.sourceFile}:${e.lineNumber} ${e.sample}`));
+"""
+
+
+def test_the_policy_allows_no_inline_script_or_style(live_server):
+    policy = requests.get(live_server.url + "/", timeout=5).headers["Content-Security-Policy"]
+    directives = dict(d.strip().split(" ", 1) for d in policy.split(";"))
+    assert directives["script-src"] == "'self'"
+    assert directives["style-src"] == "'self'"
+    assert "unsafe" not in policy
 
 
 def test_no_page_breaks_the_content_security_policy(live_server, browser, sim_process):
     sim_process()
     context = browser.new_context(viewport={"width": 1280, "height": 900})  # bypass_csp stays off
+    context.add_init_script(RECORD_VIOLATIONS)
     try:
         page = context.new_page()
         watch = PageWatch(page)
-        for path in PAGES:
+        violations = {}
+        for path, shown in PAGES.items():
             page.goto(live_server.url + path)
-            page.wait_for_selector("#link-server[data-state='live']", timeout=10000)
-            if path == "/":
-                page.wait_for_selector(".maplibregl-canvas", timeout=10000)  # its worker comes from blob:
-                page.wait_for_selector("#teleop-link[data-state='live']", timeout=10000)
-                page.wait_for_selector("#link-plot canvas", timeout=10000)  # uPlot draws under the policy
-            if path == "/status":
-                page.wait_for_selector("#link-plot canvas", timeout=10000)
-            if path.startswith("/plot"):
-                page.wait_for_selector("#plot-chart canvas", timeout=10000)
+            page.wait_for_selector("body[data-link='up']", timeout=15000)
+            for selector in shown:
+                page.wait_for_selector(selector, timeout=10000)
+            page.wait_for_load_state("networkidle")
+            violations[path] = page.evaluate("window.__csp")
+        for path, selector in OTHER_PAGES.items():
+            page.goto(live_server.url + path)
+            page.wait_for_selector(selector, timeout=10000)
+            page.wait_for_load_state("networkidle")
+            violations[path] = page.evaluate("window.__csp")
+        assert {path: v for path, v in violations.items() if v} == {}
         refused = [m for m in watch.console_errors if "Content Security Policy" in m or "Refused to" in m]
         assert refused == [], refused
         assert watch.console_errors == [], watch.console_errors
         assert watch.offhost == []
+    finally:
+        context.close()
+
+
+def test_the_dashboard_places_what_the_template_no_longer_styles(live_server, browser):
+    """The live-map thumbnail keeps its floorplan's shape with its style set from the script."""
+    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    try:
+        page = context.new_page()
+        page.goto(live_server.url + "/")
+        page.wait_for_selector("body[data-link='up']", timeout=15000)
+        thumb = page.locator("#livemap-thumb")
+        width, height = int(thumb.get_attribute("data-width")), int(thumb.get_attribute("data-height"))
+        assert page.evaluate("getComputedStyle(document.getElementById('livemap-thumb')).aspectRatio") \
+            == f"{width} / {height}"
     finally:
         context.close()
