@@ -207,6 +207,7 @@ class ViewerRate:
         self._fits_since: float | None = None
         self._stepped = clock()
         self._blocked: set[int] = set()  # steps the server refused (producer cap)
+        self._in_use = 0  # the step of the last frame sent
         self.queued = 0  # the socket's queued bytes at the last look
         self.queued_max = 0  # the most seen just before a frame was written
         self.drain_s: float | None = None
@@ -243,13 +244,15 @@ class ViewerRate:
         self._last = (started, nbytes)
         self.queued_max = max(self.queued_max, queued_before)
         index = self.index if step_index is None else step_index
+        self._in_use = index
         learned = self._sizes.get(index)
         self._sizes[index] = nbytes if learned is None else 0.7 * learned + 0.3 * nbytes
         self.meter.sent(nbytes, size, self.steps[index].quality)
 
     def refused(self, index: int) -> None:
-        """The server cannot open step `index` now (too many different streams): stay where we are."""
+        """The server cannot open step `index` (too many different streams): back to the step in use."""
         self._blocked.add(index)
+        self.index = self._in_use
 
     # --- inside ---
 
