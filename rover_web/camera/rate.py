@@ -350,8 +350,9 @@ class ViewerRate:
     def report(self) -> dict:
         path = self.path_bps()
         rate = self.rate_bps()
-        return {**self.meter.report(), "step": self.index, "steps": len(self.steps),
-                "scale": self.step.scale, "target_kbps": None if rate == math.inf else round(rate * 8 / 1000, 1),
+        return {**self.meter.report(), "step": self._in_use, "steps": len(self.steps),
+                "scale": self.steps[self._in_use].scale,
+                "target_kbps": None if rate == math.inf else round(rate * 8 / 1000, 1),
                 "path_kbps": None if path is None else round(path * 8 / 1000, 1),
                 "queued_bytes": self.queued, "queued_max_bytes": self.queued_max,
                 "drain_ms": None if self.drain_s is None else round(1000 * self.drain_s, 1)}
