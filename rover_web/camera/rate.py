@@ -33,17 +33,21 @@ from dataclasses import dataclass
 
 # Bytes a viewer's socket may still hold when the next frame is written: small, so the video
 # never builds a queue at the bottleneck; not zero, so the next frame's first bytes can follow
-# the previous frame's last ones without a round trip of silence on a fast path.
-# On a slow path the budget shrinks to QUEUE_BUDGET_S of the path's rate (at least 2 kB).
+# the previous frame's last ones without a round trip of silence on a fast path. A quarter of
+# the last frame, between 2 and 16 kB: the queue left is always a small part of one frame.
 QUEUE_BUDGET_BYTES = 16 * 1024
-QUEUE_BUDGET_S = 0.025
-# A frame that drained within this time tells nothing about the path's rate (it was not busy).
+MIN_QUEUE_BUDGET_BYTES = 2048
+# A frame that drained within this time was not held up: the path is at least bytes / this fast.
 MIN_SAMPLE_S = 0.010
 BACKOFF = 0.85  # share of the measured rate aimed at, leaving room for teleop and events
 PROBE_PER_S = 0.05  # how fast it climbs beyond that soon after the path last pushed back (+5 % a second)
 FREE_PER_S = 0.5  # ... and once it has not for CALM_S (the link may have got better: find out soon)
 CALM_S = 5.0
-SAMPLE_WINDOW_S = 10.0  # how long drain samples count towards the path's rate
+# The path's rate is the median of the last SAMPLES drain samples (of at most SAMPLE_WINDOW_S):
+# a frame held up now and then (a busy reader, a retransmission) does not lower it, while a path
+# that holds up most frames does within a dozen of them.
+SAMPLES = 20
+SAMPLE_WINDOW_S = 10.0
 # Below this frame rate, quality and then size are lowered instead. It also bounds how long one
 # frame holds the bottleneck (about BACKOFF / FPS_FLOOR s), which is what an e-stop reply may
 # wait behind: 85 ms at 10.
@@ -198,7 +202,7 @@ class ViewerRate:
         self._member = budget.join() if budget else None
         self._share = math.inf
         self._sizes: dict[int, float] = {}  # step index -> learned bytes per frame
-        self._samples: deque[tuple[float, float]] = deque()  # (time, delivered bytes/s)
+        self._samples: deque[tuple[float, float]] = deque(maxlen=SAMPLES)  # (time, delivered bytes/s)
         self._pending: tuple[float, int, int] | None = None  # the frame draining: (written at, bytes, queued before)
         self._last: tuple[float, int] | None = None  # the last frame written: (at, bytes)
         self._adjusted = clock()
@@ -227,7 +231,7 @@ class ViewerRate:
         now = self._clock()
         self.queued = queued
         if self._pending is not None:
-            if queued > self.queue_limit():
+            if queued > self.queue_limit(self._pending[1]):
                 return 0.002 if now - self._pending[0] < 0.02 else 0.01
             self._drained(now, queued)
         self._choose_step(now)
@@ -256,12 +260,9 @@ class ViewerRate:
 
     # --- inside ---
 
-    def queue_limit(self) -> int:
-        """The bytes the socket may hold when the next frame is written."""
-        path = self.path_bps()
-        if path is None:
-            return self.queue_budget
-        return int(min(self.queue_budget, max(2048, path * QUEUE_BUDGET_S)))
+    def queue_limit(self, frame_bytes: int) -> int:
+        """The bytes the socket may hold when the frame after one of `frame_bytes` is written."""
+        return int(max(MIN_QUEUE_BUDGET_BYTES, min(self.queue_budget, frame_bytes / 4)))
 
     def rate_bps(self) -> float:
         """What this viewer aims at now: its path, its cap and its share of the total budget."""
@@ -281,14 +282,21 @@ class ViewerRate:
         self._adjusted = now
         while self._samples and now - self._samples[0][0] > SAMPLE_WINDOW_S:
             self._samples.popleft()
-        if took > MIN_SAMPLE_S:
-            delivered = max(1, before + nbytes - queued)
-            rate = delivered / took
+        if before + nbytes <= self.queue_limit(nbytes):
+            rate = None  # the frame fitted under the budget: no measurement, only room to spare
+        elif took > MIN_SAMPLE_S:
+            rate = max(1, before + nbytes - queued) / took  # what left while the socket was busy
+        else:
+            rate = (before + nbytes - queued) / MIN_SAMPLE_S  # not held up: at least this fast
+        if rate is not None:
             self._samples.append((now, rate))
-            if took > interval:  # slower than aimed at
-                self.target_bps = BACKOFF * rate
-                self._pushed_back = now
-                return
+        if rate is not None and took > MIN_SAMPLE_S and took > interval:  # slower than aimed at
+            # Down to what was delivered, but by at most half at a time: one frame held up
+            # (a busy reader) is not yet a slower link.
+            sending = self.meter.rates()[1]
+            self.target_bps = max(BACKOFF * rate, 0.5 * min(self.target_bps, sending))
+            self._pushed_back = now
+            return
         if took < 0.5 * interval or took <= MIN_SAMPLE_S:  # room to spare
             known = self.path_bps()
             if known is not None and self.target_bps < BACKOFF * known:
