@@ -3,18 +3,20 @@ JPEG quality and size that fit it. Pure Python; the clock is injected.
 
 The server learns the path from its own socket, with no help from the client (curl and <img>
 work as before): after writing a frame it watches the socket's queued bytes (SIOCOUTQ: sent but
-not yet acknowledged, plus not yet sent) until they fall below QUEUE_BUDGET_BYTES. That drain
-time is the measurement, and the rule that follows from it is what keeps the bottleneck's buffer
+not yet acknowledged, plus not yet sent) until they fall below a budget (a quarter of the frame,
+2 to 16 kB). That drain time is the measurement, and the rule that follows from it is what keeps the bottleneck's buffer
 empty: a new frame never goes into the socket while the previous one is still queued beyond the
 budget, so at most about one frame of video stands in front of an e-stop reply or a teleop frame.
 
 From the drain times a viewer keeps a target rate (bytes/s) and paces its frames to it:
 - a frame that took longer to drain than its pacing interval means the path is slower than the
-  target: the target drops to BACKOFF × the rate that frame was delivered at;
+  target: the target drops to BACKOFF × the rate that frame was delivered at (by at most half
+  at a time);
 - a frame that drained in less than half its interval means there is room: the target goes
-  back at once to BACKOFF × the path's recent median rate, and beyond that climbs slowly (probing, in
-  case the link got better; faster once the path has not pushed back for CALM_S), so a brief
-  stall costs a moment and a deep buffer is not refilled at once.
+  back at once to BACKOFF × the path's median rate over its last SAMPLES frames, and beyond
+  that climbs slowly (probing, in case the link got better; faster once the path has not pushed
+  back for CALM_S). So a brief stall or a busy reader costs a moment, a path that holds up most
+  frames lowers the rate within a dozen frames, and a deep buffer is not refilled at once.
 The target is also held under the per-viewer cap and the viewer's fair share of the total video
 budget (Budget). Frame rate is lowered first (frames are paced, the freshest one is sent); when
 even FPS_FLOOR frames a second do not fit, the JPEG quality steps down, then the size (Ladder);
@@ -203,7 +205,8 @@ class ViewerRate:
         self._share = math.inf
         self._sizes: dict[int, float] = {}  # step index -> learned bytes per frame
         self._samples: deque[tuple[float, float]] = deque(maxlen=SAMPLES)  # (time, delivered bytes/s)
-        self._pending: tuple[float, int, int] | None = None  # the frame draining: (written at, bytes, queued before)
+        # The frame draining: (written at, bytes, queued before, watched closely since it was written).
+        self._pending: tuple[float, int, int, bool] | None = None
         self._last: tuple[float, int] | None = None  # the last frame written: (at, bytes)
         self._adjusted = clock()
         self._pushed_back = -math.inf  # when a frame last drained slower than aimed at
@@ -226,25 +229,60 @@ class ViewerRate:
 
     # --- the stream loop's side ---
 
-    def wait_s(self, queued: int) -> float:
-        """Seconds until the next frame may be written (0: now), given the socket's queued bytes."""
+    def pace_s(self, queued: int) -> float:
+        """Seconds until the next frame is due at the target rate (0: now), given the socket's
+        queued bytes. While it says wait, the loop asks again within a few ms, so the frame's
+        drain time is measured on the way. The loop then takes the newest message and asks hold_s
+        before writing it."""
         now = self._clock()
-        self.queued = queued
-        if self._pending is not None:
-            if queued > self.queue_limit(self._pending[1]):
-                return 0.002 if now - self._pending[0] < 0.02 else 0.01
-            self._drained(now, queued)
         self._choose_step(now)
         if self._last is None:
             return 0.0
         at, nbytes = self._last
-        return max(0.0, at + nbytes / self.rate_bps() - now)
+        pause = max(0.0, at + nbytes / self.rate_bps() - now)
+        if pause > 0 and self._pending is not None:
+            pause = min(pause, self._look(now, queued))
+        return pause
+
+    def _look(self, now: float, queued: int) -> float:
+        """Watch the frame draining: seconds until the next look, or inf once it has left."""
+        self.queued = queued
+        started, nbytes, before, _ = self._pending
+        if queued > self.queue_limit(nbytes):
+            self._pending = (started, nbytes, before, True)
+            return 0.002 if now - started < 0.02 else 0.01
+        self._drained(now, queued)
+        return math.inf
+
+    def hold_s(self, queued: int) -> float:
+        """Seconds to wait before looking at the socket again (0: write now), given its queued bytes.
+
+        The first look usually comes a frame interval after the write: if the frame has left by
+        then, the path kept up with the camera and nothing is measured (when it left is not
+        known). If not, the loop watches closely from then on, and the time it took is a sample.
+        """
+        now = self._clock()
+        self.queued = queued
+        if self._pending is None:
+            return 0.0
+        started, nbytes, before, watching = self._pending
+        if not watching and queued <= self.queue_limit(nbytes) and now - started > MIN_SAMPLE_S:
+            self._pending = None  # left at some time since: not held up by the path
+            self._sample(now, math.inf)
+            self._room(now)
+            self._choose_step(now)
+            return 0.0
+        wait = self._look(now, queued)
+        if wait < math.inf:
+            return wait
+        self._choose_step(now)
+        return 0.0
 
     def sent(self, nbytes: int, started: float, queued_before: int, *, size: tuple[int, int] | None = None,
              step_index: int | None = None) -> None:
         """A frame of `nbytes` was written (the write began at `started`, with `queued_before` bytes
         already in the socket)."""
-        self._pending = (started, nbytes, queued_before)
+        self._pending = (started, nbytes, queued_before, False)
         self._last = (started, nbytes)
         self.queued_max = max(self.queued_max, queued_before)
         index = self.index if step_index is None else step_index
@@ -269,41 +307,47 @@ class ViewerRate:
         return min(self.target_bps, self.max_bps, self._share)
 
     def path_bps(self) -> float | None:
-        """The path's recent median delivery rate, None before a frame has been slow enough to tell."""
+        """The path's median delivery rate over its last frames (inf when most were not held up),
+        None before the first."""
         return statistics.median(r for _, r in self._samples) if self._samples else None
 
     def _drained(self, now: float, queued: int) -> None:
-        started, nbytes, before = self._pending
+        started, nbytes, before, _ = self._pending
         self._pending = None
         took = now - started
         self.drain_s = took
         interval = nbytes / self.rate_bps() if self.rate_bps() < math.inf else 0.0
-        dt = min(1.0, now - self._adjusted)
-        self._adjusted = now
-        while self._samples and now - self._samples[0][0] > SAMPLE_WINDOW_S:
-            self._samples.popleft()
-        if before + nbytes <= self.queue_limit(nbytes):
-            rate = None  # the frame fitted under the budget: no measurement, only room to spare
-        elif took > MIN_SAMPLE_S:
-            rate = max(1, before + nbytes - queued) / took  # what left while the socket was busy
-        else:
-            rate = (before + nbytes - queued) / MIN_SAMPLE_S  # not held up: at least this fast
-        if rate is not None:
-            self._samples.append((now, rate))
-        if rate is not None and took > MIN_SAMPLE_S and took > interval:  # slower than aimed at
+        held = took > MIN_SAMPLE_S and before + nbytes > self.queue_limit(nbytes)
+        # What left while the socket was busy; a frame not held up counts as "fast enough".
+        rate = max(1, before + nbytes - queued) / took if held else math.inf
+        self._sample(now, rate)
+        if held and took > interval:  # slower than aimed at
             # Down to what was delivered, but by at most half at a time: one frame held up
             # (a busy reader) is not yet a slower link.
             sending = self.meter.rates()[1]
             self.target_bps = max(BACKOFF * rate, 0.5 * min(self.target_bps, sending))
-            self._pushed_back = now
+            self._pushed_back = self._adjusted = now
             return
-        if took < 0.5 * interval or took <= MIN_SAMPLE_S:  # room to spare
-            known = self.path_bps()
-            if known is not None and self.target_bps < BACKOFF * known:
-                self.target_bps = BACKOFF * known  # a rate the path has carried lately: at once
-            else:
-                calm = now - self._pushed_back >= CALM_S
-                self.target_bps *= 1 + (FREE_PER_S if calm else PROBE_PER_S) * dt
+        if took < 0.5 * interval or took <= MIN_SAMPLE_S:
+            self._room(now)
+
+    def _sample(self, now: float, rate: float) -> None:
+        while self._samples and now - self._samples[0][0] > SAMPLE_WINDOW_S:
+            self._samples.popleft()
+        self._samples.append((now, rate))
+
+    def _room(self, now: float) -> None:
+        """The last frame left in good time: the target may rise."""
+        dt = min(1.0, now - self._adjusted)
+        self._adjusted = now
+        known = self.path_bps()
+        if known is not None and self.target_bps < BACKOFF * known:
+            # A rate the path has carried lately (or, when most frames were not held up, no
+            # limit): at once.
+            self.target_bps = BACKOFF * known
+        else:
+            calm = now - self._pushed_back >= CALM_S
+            self.target_bps *= 1 + (FREE_PER_S if calm else PROBE_PER_S) * dt
 
     def frame_bytes(self, index: int) -> float | None:
         """Bytes a frame at step `index` has (learned), or would have (from the nearest learned step)."""
@@ -357,6 +401,7 @@ class ViewerRate:
 
     def report(self) -> dict:
         path = self.path_bps()
+        path = None if path == math.inf else path
         rate = self.rate_bps()
         return {**self.meter.report(), "step": self._in_use, "steps": len(self.steps),
                 "scale": self.steps[self._in_use].scale,

@@ -85,24 +85,33 @@ def plain_frames(streams: CameraStreams, client: Client, producer: FrameProducer
 
 
 def adaptive_frames(streams: CameraStreams, client: Client, producer: FrameProducer, sock, stopping):
-    """The freshest frame the viewer's path can carry (rate.py): after each frame, wait until the
-    socket has let it go and the pacing interval has passed, then send the newest message at the
-    step (quality, size) the rate control chose. Code after a `yield` runs once the server has
-    handed the part to the socket."""
+    """The freshest frame the viewer's path can carry (rate.py): wait for the pacing interval
+    (watching the last frame leave the socket meanwhile), take the newest message at the step
+    (quality, size) the rate control chose, wait until the socket has let the last frame go
+    down to a small budget, and write the newest frame then. Code after a `yield` runs once the
+    server has handed the part to the socket."""
     yield OPENING
     rate = client.rate
     seq, in_use, base = 0, 0, None  # base: the size of a full-size frame, for the smaller steps
     checked = time.monotonic()
     rate_read = -SOURCE_RATE_EVERY_S
+
+    def wait(seconds: float) -> bool:
+        """False when the stream must end (shutdown, or the browser went away)."""
+        nonlocal checked
+        now = time.monotonic()
+        if now - checked >= LIVENESS_CHECK_S:
+            checked = now
+            if peer_gone(sock):
+                return False
+        return not stopping.wait(min(seconds, 0.05))
+
     while not stopping.is_set():
-        while (wait := rate.wait_s(queued_bytes(sock) or 0)) > 0:
-            now = time.monotonic()
-            if now - checked >= LIVENESS_CHECK_S:
-                checked = now
-                if peer_gone(sock):
-                    return
-            if stopping.wait(min(wait, 0.05)):
+        pause = rate.pace_s(queued_bytes(sock) or 0)
+        if pause > 0:
+            if not wait(pause):
                 return
+            continue
         wanted = output_key(client.asked, rate.step, base)
         if wanted != client.key:
             try:
@@ -116,13 +125,20 @@ def adaptive_frames(streams: CameraStreams, client: Client, producer: FrameProdu
             rate.source_fps = producer.arrivals.snapshot(stale_after_s=2.0)["rate_hz"] or None
         try:
             got = producer.next_frame(seq, LIVENESS_CHECK_S)
+            if got is None:
+                checked = time.monotonic()
+                if peer_gone(sock):
+                    return
+                continue
+            held = False
+            while (hold := rate.hold_s(queued_bytes(sock) or 0)) > 0:
+                held = True
+                if not wait(hold):
+                    return
+            if held:  # a newer message may have come while the socket drained: send that one
+                got = producer.next_frame(got[0], 0.0) or got
         except StreamClosed:
             return
-        if got is None:
-            checked = time.monotonic()
-            if peer_gone(sock):
-                return
-            continue
         seq, jpeg = got
         if in_use == 0 and jpeg.error is None:
             base = (jpeg.width, jpeg.height)

@@ -16,8 +16,7 @@ export function pollSnapshots(img, url, show, fail) {
   async function next() {
     const started = performance.now();
     try {
-      const response = await fetch(at(url) + `${url.includes('?') ? '&' : '?'}_=${Date.now()}`,
-        { cache: 'no-store' });
+      const response = await fetch(at(url), { cache: 'no-store' });
       if (!response.ok) throw await errorFrom(response);
       const blob = await response.blob();
       if (stopped) return;

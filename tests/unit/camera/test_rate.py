@@ -58,7 +58,8 @@ def frame_size(rate, index):
 
 
 class Viewer:
-    """The stream loop of rover_web/camera/routes.py, in simulated time, with a 30 Hz camera."""
+    """The stream loop of rover_web/camera/routes.py, in simulated time, with a 30 Hz camera:
+    wait for the pacing, take the newest frame, wait for the socket to let the last one go, write."""
 
     def __init__(self, clock, link, rate, camera_hz=30.0):
         self.clock, self.link, self.rate = clock, link, rate
@@ -69,15 +70,19 @@ class Viewer:
 
     def run_until(self, end):
         while self.clock.t < end:
-            wait = self.rate.wait_s(self.link.queued())
-            if wait > 0:
-                self.clock.t += min(wait, 0.05)
+            pause = self.rate.pace_s(self.link.queued())
+            if pause > 0:
+                self.clock.t += min(pause, 0.05)
                 continue
             frame = math.floor(self.clock.t * self.camera_hz)
             if frame <= self.last_frame:  # the newest frame was sent already: wait for the next one
                 self.clock.t = (self.last_frame + 1) / self.camera_hz + 1e-9
                 continue
-            self.last_frame = frame
+            hold = self.rate.hold_s(self.link.queued())
+            if hold > 0:
+                self.clock.t += hold
+                continue
+            self.last_frame = math.floor(self.clock.t * self.camera_hz)  # the newest, after any hold
             index = self.rate.index
             nbytes = frame_size(self.rate, index)
             before = self.link.queued()
