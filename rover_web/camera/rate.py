@@ -229,11 +229,11 @@ class ViewerRate:
 
     # --- the stream loop's side ---
 
-    def pace_s(self, queued: int) -> float:
-        """Seconds until the next frame is due at the target rate (0: now), given the socket's
-        queued bytes. While it says wait, the loop asks again within a few ms, so the frame's
-        drain time is measured on the way. The loop then takes the newest message and asks hold_s
-        before writing it."""
+    def pace_s(self, queued: Callable[[], int]) -> float:
+        """Seconds until the next frame is due at the target rate (0: now); `queued()` reads the
+        socket's queued bytes (only while pacing holds a frame back). While it says wait, the loop
+        asks again within a few ms, so the frame's drain time is measured on the way. The loop then
+        takes the newest message and asks hold_s before writing it."""
         now = self._clock()
         self._choose_step(now)
         if self._last is None:
@@ -241,7 +241,7 @@ class ViewerRate:
         at, nbytes = self._last
         pause = max(0.0, at + nbytes / self.rate_bps() - now)
         if pause > 0 and self._pending is not None:
-            pause = min(pause, self._look(now, queued))
+            pause = min(pause, self._look(now, queued()))
         return pause
 
     def _look(self, now: float, queued: int) -> float:

@@ -107,7 +107,7 @@ def adaptive_frames(streams: CameraStreams, client: Client, producer: FrameProdu
         return not stopping.wait(min(seconds, 0.05))
 
     while not stopping.is_set():
-        pause = rate.pace_s(queued_bytes(sock) or 0)
+        pause = rate.pace_s(lambda: queued_bytes(sock) or 0)
         if pause > 0:
             if not wait(pause):
                 return

@@ -60,7 +60,9 @@ if (card) {
   function showStats(report) {
     stats.textContent = report ? describe(report) : '';
     card.dataset.cameraFps = report ? report.fps.toFixed(2) : '';
-    slowReports = report && mode === 'live' && report.fps < SLOW_FPS ? slowReports + 1 : 0;
+    // Slow because of the link (the server lowered quality or size), not a camera that is slow itself.
+    const slow = report && mode === 'live' && report.fps < SLOW_FPS && (!report.adapt || report.step > 0);
+    slowReports = slow ? slowReports + 1 : 0;
     if (slowReports >= SLOW_REPORTS) suggest.hidden = false;
   }
 

@@ -70,7 +70,7 @@ class Viewer:
 
     def run_until(self, end):
         while self.clock.t < end:
-            pause = self.rate.pace_s(self.link.queued())
+            pause = self.rate.pace_s(self.link.queued)
             if pause > 0:
                 self.clock.t += min(pause, 0.05)
                 continue
