@@ -270,13 +270,9 @@ class ViewerRate:
             self._pending = None  # left at some time since: not held up by the path
             self._sample(now, math.inf)
             self._room(now)
-            self._choose_step(now)
             return 0.0
         wait = self._look(now, queued)
-        if wait < math.inf:
-            return wait
-        self._choose_step(now)
-        return 0.0
+        return wait if wait < math.inf else 0.0
 
     def sent(self, nbytes: int, started: float, queued_before: int, *, size: tuple[int, int] | None = None,
              step_index: int | None = None) -> None:
@@ -340,6 +336,8 @@ class ViewerRate:
         """The last frame left in good time: the target may rise."""
         dt = min(1.0, now - self._adjusted)
         self._adjusted = now
+        if self.target_bps == math.inf:
+            return  # nothing has held a frame up yet
         known = self.path_bps()
         if known is not None and self.target_bps < BACKOFF * known:
             # A rate the path has carried lately (or, when most frames were not held up, no
@@ -363,6 +361,8 @@ class ViewerRate:
         return math.inf if not size or rate == math.inf else rate / size
 
     def _choose_step(self, now: float) -> None:
+        if self.index == 0 and self._budget is None and self.rate_bps() == math.inf:
+            return  # the usual case on a fast path: nothing to choose
         top = self.frame_bytes(0)
         fps = self.source_fps or 30.0
         demand = fps * top * 1.25 if top else math.inf  # the most this viewer could use
