@@ -214,6 +214,14 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("CAMERA_MAX_OUTPUT_PIXELS", 3840 * 2160, "int",
             "largest width × height a stream is encoded at (a larger asked size is refused, a derived one "
             "scaled down)", 256, 64 * 1024 * 1024),
+    Setting("CAMERA_ADAPT", True, "bool",
+            "fit each MJPEG viewer's frame rate, quality and size to what its link delivers (docs/camera.md); "
+            "false: every frame the camera makes, as asked"),
+    Setting("CAMERA_VIEWER_MAX_KBPS", 0, "int",
+            "most kbit/s one MJPEG viewer gets (0: no cap beyond its link); needs CAMERA_ADAPT", 0, 10_000_000),
+    Setting("CAMERA_TOTAL_MAX_KBPS", 0, "int",
+            "most kbit/s all MJPEG viewers together get, shared fairly (0: no total cap); needs CAMERA_ADAPT",
+            0, 10_000_000),
     # --- topic browser ---
     Setting("TOPICS_REFRESH_S", 1.0, "float",
             "how often the topic list (`topics` channel) is re-read from the ROS graph",

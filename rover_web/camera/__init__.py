@@ -1,10 +1,11 @@
 """Camera streaming in the app's own process: GET /stream (MJPEG), GET /snapshot, the camera panel.
 
-Replaces web_video_server. One FrameProducer (one ROS subscription) per distinct
-(topic, type, QoS, width, height, quality): made by the first viewer, shared by the others and
-destroyed ROVER_WEB_CAMERA_IDLE_TIMEOUT_S after the last one leaves. Frames are encoded in
-request threads, once each (see stream.py), never on the ROS executor. GET /api/camera/streams
-tells who watches what.
+Replaces web_video_server. One FrameProducer per distinct (topic, type, QoS, width, height,
+quality): made by the first viewer, shared by the others and destroyed
+ROVER_WEB_CAMERA_IDLE_TIMEOUT_S after the last one leaves; the producers of one topic share one
+ROS subscription (FrameSource). Frames are encoded in request threads, once each (see stream.py),
+never on the ROS executor. Each MJPEG viewer's rate, quality and size follow its link (rate.py).
+GET /api/camera/streams tells who watches what, GET /api/camera/viewers what each viewer gets.
 """
 
 from __future__ import annotations

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 
 from rover_web.web.validate import InvalidInput, topic_name
 
 QOS_PROFILES = ("default", "sensor_data")
+VIEWER_LABEL = re.compile(r"[A-Za-z0-9_-]{1,64}\Z")
 # web_video_server's `type` is the stream format; MJPEG is the one this server makes.
 STREAM_TYPES = ("mjpeg",)
 
@@ -49,3 +51,13 @@ def parse_stream_args(args: Mapping[str, str], *, max_dimension: int, default_qu
         msg_type = msg_type or stream_type  # type=sensor_msgs/msg/Image works too
     return {"topic": topic, "width": width, "height": height,
             "quality": default_quality if quality is None else quality, "qos": qos, "msg_type": msg_type}
+
+
+def viewer_label(args: Mapping[str, str]) -> str | None:
+    """The optional `viewer` a page tags its stream with, to find its own figures in GET /api/camera/viewers."""
+    label = args.get("viewer")
+    if label is None or label == "":
+        return None
+    if not VIEWER_LABEL.match(label):
+        raise InvalidInput("'viewer' must be 1 to 64 letters, digits, '-' or '_'", "bad_value")
+    return label

@@ -1,10 +1,14 @@
-"""GET /stream (MJPEG), GET /snapshot (one JPEG) and GET /api/camera/streams (who watches what)."""
+"""GET /stream (MJPEG), GET /snapshot (one JPEG), GET /api/camera/streams (who watches what) and
+GET /api/camera/viewers (what each viewer gets)."""
 
 from __future__ import annotations
+
+import time
 
 from flask import Blueprint, Response, jsonify, request
 
 from rover_web.auth import signed_in_name
+from rover_web.core.leases import Closed, Full
 from rover_web.core.state import current_feature
 from rover_web.web.connection import peer_gone
 from rover_web.web.http import ApiError, error_response, too_many
@@ -12,13 +16,18 @@ from rover_web.web.streams import once, opening, refuse_cross_site
 from rover_web.web.validate import InvalidInput
 
 from .mjpeg import MIMETYPE, OPENING, multipart_part
-from .service import CameraStreams, CannotSubscribe, StreamRefused, Unavailable, UnknownTopic
-from .stream import StreamClosed
+from .params import viewer_label
+from .rate import Step
+from .sendq import queued_bytes
+from .service import CameraStreams, CannotSubscribe, Client, StreamRefused, Unavailable, UnknownTopic
+from .stream import FrameProducer, StreamClosed, StreamKey
 
 bp = Blueprint("camera", __name__)
 
 # How often a stream with no new frame checks that its browser is still there.
 LIVENESS_CHECK_S = 1.0
+# How often an adaptive stream re-reads the camera's rate (the frame-rate floor depends on it).
+SOURCE_RATE_EVERY_S = 1.0
 NO_CACHE = {"Cache-Control": "no-cache, no-store, must-revalidate", "Pragma": "no-cache", "Expires": "0"}
 
 STATUS = {UnknownTopic: 404, Unavailable: 503, CannotSubscribe: 400}
@@ -39,32 +48,113 @@ def stream():
     streams = current_feature(CameraStreams)
     with opening("mjpeg") as slot:
         key = streams.key_for(request.args)
+        label = viewer_label(request.args)
         producer = streams.acquire(key, slot.client)
-    release = once(lambda: streams.release(key, slot.client), slot.release)
+    client = streams.client(key, label, slot.client)
+    # The viewer may move to other outputs of its topic (adaptation): release the one it holds last.
+    release = once(lambda: streams.release(client.key, client.owner), slot.release,
+                   lambda: streams.client_left(client))
 
     sock = request.environ.get("werkzeug.socket") or request.environ.get("gunicorn.socket")
     stopping = streams.rover.stopping
-
-    def frames():
-        yield OPENING  # headers go out now, not at the first frame
-        seq = 0
-        while not stopping.is_set():
-            try:
-                got = producer.next_frame(seq, LIVENESS_CHECK_S)
-            except StreamClosed:
-                return
-            if got is None:
-                if peer_gone(sock):
-                    return
-                continue
-            seq, jpeg = got
-            yield multipart_part(jpeg)
-
-    response = Response(frames(), mimetype=MIMETYPE, headers={**NO_CACHE, "X-Accel-Buffering": "no"})
+    frames = adaptive_frames if client.rate is not None else plain_frames
+    response = Response(frames(streams, client, producer, sock, stopping), mimetype=MIMETYPE,
+                        headers={**NO_CACHE, "X-Accel-Buffering": "no"})
     # WSGI servers call close() however the response ends (done, browser gone, error), even if
     # the generator never started, so the viewer is always released exactly once.
     response.call_on_close(release)
     return response
+
+
+def plain_frames(streams: CameraStreams, client: Client, producer: FrameProducer, sock, stopping):
+    """Every frame the camera makes, as asked (ROVER_WEB_CAMERA_ADAPT=false)."""
+    yield OPENING  # headers go out now, not at the first frame
+    seq = 0
+    while not stopping.is_set():
+        try:
+            got = producer.next_frame(seq, LIVENESS_CHECK_S)
+        except StreamClosed:
+            return
+        if got is None:
+            if peer_gone(sock):
+                return
+            continue
+        seq, jpeg = got
+        part = multipart_part(jpeg)
+        yield part
+        client.meter.sent(len(part), (jpeg.width, jpeg.height), client.key.quality)
+
+
+def adaptive_frames(streams: CameraStreams, client: Client, producer: FrameProducer, sock, stopping):
+    """The freshest frame the viewer's path can carry (rate.py): wait for the pacing interval
+    (watching the last frame leave the socket meanwhile), take the newest message at the step
+    (quality, size) the rate control chose, wait until the socket has let the last frame go
+    down to a small budget, and write the newest frame then. Code after a `yield` runs once the
+    server has handed the part to the socket."""
+    yield OPENING
+    rate = client.rate
+    seq, in_use, base = 0, 0, None  # base: the size of a full-size frame, for the smaller steps
+    checked = time.monotonic()
+    rate_read = -SOURCE_RATE_EVERY_S
+
+    def wait(seconds: float) -> bool:
+        """False when the stream must end (shutdown, or the browser went away)."""
+        nonlocal checked
+        now = time.monotonic()
+        if now - checked >= LIVENESS_CHECK_S:
+            checked = now
+            if peer_gone(sock):
+                return False
+        return not stopping.wait(min(seconds, 0.05))
+
+    while not stopping.is_set():
+        pause = rate.pace_s(lambda: queued_bytes(sock) or 0)
+        if pause > 0:
+            if not wait(pause):
+                return
+            continue
+        wanted = output_key(client.asked, rate.step, base)
+        if wanted != client.key:
+            try:
+                producer = streams.switch(client.key, wanted, client.owner)
+                client.key, in_use = wanted, rate.index
+            except (Full, Closed):
+                rate.refused(rate.index)
+        now = time.monotonic()
+        if now - rate_read >= SOURCE_RATE_EVERY_S:
+            rate_read = now
+            rate.source_fps = producer.arrivals.snapshot(stale_after_s=2.0)["rate_hz"] or None
+        try:
+            got = producer.next_frame(seq, LIVENESS_CHECK_S)
+            if got is None:
+                checked = time.monotonic()
+                if peer_gone(sock):
+                    return
+                continue
+            held = False
+            while (hold := rate.hold_s(queued_bytes(sock) or 0)) > 0:
+                held = True
+                if not wait(hold):
+                    return
+            if held:  # a newer message may have come while the socket drained: send that one
+                got = producer.next_frame(got[0], 0.0) or got
+        except StreamClosed:
+            return
+        seq, jpeg = got
+        if in_use == 0 and jpeg.error is None:
+            base = (jpeg.width, jpeg.height)
+        part = multipart_part(jpeg)
+        started, before = time.monotonic(), queued_bytes(sock) or 0
+        yield part
+        rate.sent(len(part), started, before, size=(jpeg.width, jpeg.height), step_index=in_use)
+
+
+def output_key(asked: StreamKey, step: Step, base: tuple[int, int] | None) -> StreamKey:
+    """The output (shared by every viewer on the same step) for `step` of what was asked."""
+    if step.scale == 1.0 or base is None:
+        return asked._replace(quality=step.quality)
+    return asked._replace(width=max(1, round(base[0] * step.scale)), height=max(1, round(base[1] * step.scale)),
+                          quality=step.quality)
 
 
 @bp.get("/snapshot")
@@ -98,3 +188,10 @@ def snapshot():
 def streams_status():
     streams = current_feature(CameraStreams)
     return jsonify(viewers=streams.viewers, streams=streams.describe())
+
+
+@bp.get("/api/camera/viewers")
+def viewers_status():
+    """What each /stream viewer gets: fps, size, kbit/s, and the rate control's view of its path."""
+    streams = current_feature(CameraStreams)
+    return jsonify(adapt=streams.adapt, viewers=streams.clients(viewer_label(request.args)))

@@ -16,7 +16,8 @@ from rover_web.web.validate import InvalidInput
 from . import imaging
 from . import msgs as camera_msgs
 from .params import parse_stream_args
-from .stream import FrameProducer, StreamKey
+from .rate import Budget, Meter, ViewerRate
+from .stream import FrameProducer, FrameSource, SourceKey, StreamKey, source_key
 
 log = logging.getLogger(__name__)
 
@@ -41,6 +42,21 @@ class CannotSubscribe(StreamRefused):
     """The ROS subscription could not be made."""
 
 
+class Client:
+    """One /stream viewer: what it asked for, the output it gets now, and what it is sent."""
+
+    def __init__(self, id: int, label: str | None, key: StreamKey, rate: ViewerRate | None):
+        self.id, self.label, self.asked, self.key, self.rate = id, label, key, key, rate
+        self.owner: str | None = None
+        self.meter = rate.meter if rate is not None else Meter()
+
+    def report(self) -> dict:
+        report = self.rate.report() if self.rate is not None else self.meter.report()
+        return {"id": self.id, "viewer": self.label, "topic": self.asked.topic, "adapt": self.rate is not None,
+                "asked": {"width": self.asked.width, "height": self.asked.height, "quality": self.asked.quality},
+                **report}
+
+
 class CameraStreams:
     """The producers of one app, its viewer limit and the encoding settings."""
 
@@ -56,22 +72,44 @@ class CameraStreams:
         self.producers: Leases[FrameProducer] = Leases(self._open, self._close,
                                                        config["ROVER_WEB_CAMERA_IDLE_TIMEOUT_S"],
                                                        max_keys=config["ROVER_WEB_CAMERA_MAX_PRODUCERS"])
+        self.adapt = config["ROVER_WEB_CAMERA_ADAPT"]
+        self.viewer_max_bps = config["ROVER_WEB_CAMERA_VIEWER_MAX_KBPS"] * 1000 / 8 or None
+        self.budget = Budget(config["ROVER_WEB_CAMERA_TOTAL_MAX_KBPS"] * 1000 / 8 or None)
+        self._sources: dict[SourceKey, FrameSource] = {}
+        self._source_lock = threading.Lock()
+        self._clients: dict[int, Client] = {}
+        self._next_client = 0
         self._viewers = 0
         self._lock = threading.Lock()
 
     # --- producers ---
 
     def _open(self, key: StreamKey) -> FrameProducer:
+        """Called under the producers' lock, so two outputs cannot both make a subscription."""
         producer = FrameProducer(key, lambda raw: self._encode(key, raw))
-        read = camera_msgs.frame_reader(key.msg_type)
-        producer.subscription = self.rover.runtime.subscribe(
-            key.msg_type, key.topic, lambda msg: producer.put(read(msg)), qos=key.qos, track=False)
+        skey = source_key(key)
+        with self._source_lock:
+            source = self._sources.get(skey)
+            if source is None:
+                source = FrameSource(skey)
+                read = camera_msgs.frame_reader(key.msg_type)
+                source.subscription = self.rover.runtime.subscribe(
+                    key.msg_type, key.topic, lambda msg: source.put(read(msg)), qos=key.qos, track=False)
+                self._sources[skey] = source
+            source.attach(producer)
+        producer.subscription = source.subscription
         return producer
 
     def _close(self, producer: FrameProducer) -> None:
         producer.close()
+        skey = source_key(producer.key)
+        with self._source_lock:
+            source = self._sources.get(skey)
+            if source is None or source.detach(producer):
+                return
+            del self._sources[skey]
         if self.rover.runtime.running:  # after runtime.stop the node and its subscriptions are gone
-            self.rover.runtime.destroy(producer.subscription)
+            self.rover.runtime.destroy(source.subscription)
 
     def _encode(self, key: StreamKey, raw) -> imaging.Jpeg:
         try:
@@ -143,6 +181,37 @@ class CameraStreams:
 
     def _share(self, client: str | None) -> int | None:
         return None if client is None else self.rover.config["ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT"]
+
+    def switch(self, old: StreamKey, new: StreamKey, owner: str | None = None) -> FrameProducer:
+        """A viewer moves to another output of its topic (adaptation); Full or Closed leaves it where it was.
+        For a moment it holds both: its share of encodings allows the one more."""
+        share = self._share(owner)
+        producer = self.producers.acquire(new, owner, None if share is None else share + 1)
+        self.producers.release(old, owner)
+        return producer
+
+    # --- viewers, for the camera card and the rate control ---
+
+    def client(self, key: StreamKey, label: str | None, owner: str | None = None) -> Client:
+        """A viewer's record: its rate control (or only a meter with adaptation off) and what it watches."""
+        rate = ViewerRate(key.quality, max_bps=self.viewer_max_bps, budget=self.budget) if self.adapt else None
+        with self._lock:
+            self._next_client += 1
+            client = Client(self._next_client, label, key, rate)
+            client.owner = owner  # whose share of the encodings it holds (web/streams.py)
+            self._clients[client.id] = client
+        return client
+
+    def client_left(self, client: Client) -> None:
+        with self._lock:
+            self._clients.pop(client.id, None)
+        if client.rate is not None:
+            client.rate.close()
+
+    def clients(self, label: str | None = None) -> list[dict]:
+        with self._lock:
+            clients = list(self._clients.values())
+        return [c.report() for c in clients if label is None or c.label == label]
 
     def _viewer_left(self) -> None:
         with self._lock:

@@ -33,6 +33,59 @@ class StreamKey(NamedTuple):
     quality: int
 
 
+class SourceKey(NamedTuple):
+    """What makes outputs share one ROS subscription: same topic, type and QoS."""
+
+    topic: str
+    msg_type: str
+    qos: str
+
+
+def source_key(key: StreamKey) -> SourceKey:
+    return SourceKey(key.topic, key.msg_type, key.qos)
+
+
+class FrameSource:
+    """One ROS subscription feeding the producers of every output (size, quality) of its topic.
+
+    Adaptive viewers move between outputs of one topic; one subscription for all of them keeps
+    the executor's work (and the DDS copies of a large raw image) at one per message.
+    """
+
+    def __init__(self, key: SourceKey):
+        self.key = key
+        self.subscription: Any = None
+        self._producers: list[FrameProducer] = []
+        self._latest: tuple[int, Any] | None = None
+        self._seq = 0
+        self._lock = threading.Lock()
+
+    def put(self, raw: Any) -> None:
+        with self._lock:
+            self._seq += 1
+            seq = self._seq
+            self._latest = (seq, raw)
+            producers = list(self._producers)
+        for producer in producers:
+            producer.put(raw, seq)
+
+    def attach(self, producer: FrameProducer) -> None:
+        """A new output starts from the newest message, not from the next one."""
+        with self._lock:
+            self._producers.append(producer)
+            if self._latest is not None:
+                producer.put(self._latest[1], self._latest[0])
+
+    def detach(self, producer: FrameProducer) -> int:
+        """Remove `producer`; returns how many remain."""
+        with self._lock:
+            if producer in self._producers:
+                self._producers.remove(producer)
+            if not self._producers:
+                self._latest = None
+            return len(self._producers)
+
+
 class StreamClosed(RuntimeError):
     """The producer stopped (last viewer left long ago, or the app shuts down)."""
 
@@ -60,12 +113,16 @@ class FrameProducer:
 
     # --- producer side (ROS callback thread) ---
 
-    def put(self, raw: Any) -> None:
-        """Keep the newest message; cheap on purpose, it runs on the ROS executor."""
-        self.arrivals.record()
+    def put(self, raw: Any, seq: int | None = None) -> None:
+        """Keep the newest message; cheap on purpose, it runs on the ROS executor. `seq` numbers
+        the message across every output of one topic (FrameSource), so a viewer moving to another
+        output keeps its place."""
         with self._cond:
+            if seq is not None and seq <= self._raw_seq:
+                return  # never back to an older message
+            self.arrivals.record()
             self._raw = raw
-            self._raw_seq += 1
+            self._raw_seq = self._raw_seq + 1 if seq is None else seq
             self._cond.notify_all()
 
     # --- viewer side (request threads) ---

@@ -1,11 +1,20 @@
 // Camera panel: an MJPEG <img> of the chosen image topic (GET /stream). The stream is dropped
 // while the tab is hidden, so the server can remove its subscription, and it is only requested
 // for topics the ROS graph lists as images, so a missing camera is a message, not a failed request.
+// Under the image: the fps, size and kbit/s this viewer gets (camera/stats.js); for the slowest
+// links a snapshot mode polls GET /snapshot instead (camera/snapshots.js), suggested when the
+// stream's rate is very low, and remembered per browser.
 
 import { api, at } from './api.js';
+import { describe, watchViewer } from './camera/stats.js';
+import { pollSnapshots } from './camera/snapshots.js';
 
 const card = document.getElementById('camera-card');
 const STORAGE_KEY = 'rover_web.camera.topic';
+const MODE_KEY = 'rover_web.camera.mode';
+// A stream this slow for this many reports in a row (2 s each) suggests snapshot mode.
+const SLOW_FPS = 2;
+const SLOW_REPORTS = 3;
 const RECHECK_MS = 3000;
 const IMAGE_TYPES = new Set(['sensor_msgs/msg/Image', 'sensor_msgs/msg/CompressedImage']);
 const BLANK = 'data:image/gif;base64,R0lGODlhAQABAIAAAAAAAP///yH5BAEAAAAALAAAAAABAAEAAAIBRAA7';
@@ -16,6 +25,14 @@ if (card) {
   const message = document.getElementById('camera-message');
   const snapshotLink = document.getElementById('camera-snapshot');
   const openLink = document.getElementById('camera-open');
+  const modeSelect = document.getElementById('camera-mode');
+  const stats = document.getElementById('camera-stats');
+  const suggest = document.getElementById('camera-suggest');
+  // Tags this page's stream so the server's figures for it can be found (GET /api/camera/viewers).
+  const label = `card-${Date.now().toString(36)}-${Math.random().toString(36).slice(2, 8)}`;
+  let mode = localStorage.getItem(MODE_KEY) === 'snapshots' ? 'snapshots' : 'live';
+  let stopWatching = null;
+  let slowReports = 0;
   let imageTopics = new Set((card.dataset.imageTopics || '').split(' ').filter(Boolean));
   let topic = localStorage.getItem(STORAGE_KEY) || select.value || card.dataset.defaultTopic;
   let streaming = null;  // the URL being shown, or null
@@ -34,9 +51,30 @@ if (card) {
   }
 
   function stop() {
+    if (stopWatching) { stopWatching(); stopWatching = null; }
     if (streaming === null) return;
     streaming = null;
-    img.src = BLANK;  // ends the MJPEG request; the server releases the stream
+    img.src = BLANK;  // ends the MJPEG request (or the snapshot loop); the server releases the stream
+  }
+
+  function showStats(report) {
+    stats.textContent = report ? describe(report) : '';
+    card.dataset.cameraFps = report ? report.fps.toFixed(2) : '';
+    // Slow because of the link (the server lowered quality or size), not a camera that is slow itself.
+    const slow = report && mode === 'live' && report.fps < SLOW_FPS && (!report.adapt || report.step > 0);
+    slowReports = slow ? slowReports + 1 : 0;
+    if (slowReports >= SLOW_REPORTS) suggest.hidden = false;
+  }
+
+  function startSnapshots() {
+    const url = `/snapshot?${query(topic)}&width=640`;
+    if (streaming === url) return;
+    stop();
+    streaming = url;
+    say(`snapshots of ${topic}…`);
+    img.alt = `snapshots from ${topic}`;
+    stopWatching = pollSnapshots(img, url, (figures) => { say(''); showStats(figures); },
+      (reason) => say(`snapshot of ${topic}: ${reason}`));
   }
 
   function start() {
@@ -48,12 +86,25 @@ if (card) {
       recheckTimer = setTimeout(refreshTopics, RECHECK_MS);
       return;
     }
-    const url = at(`/stream?${query(topic)}&width=640`);
+    if (mode === 'snapshots') { startSnapshots(); return; }
+    const url = at(`/stream?${query(topic)}&width=640&viewer=${label}`);
     if (streaming === url) return;
+    stop();
     streaming = url;
     say(`connecting to ${topic}…`);
     img.alt = `live image from ${topic}`;
     img.src = url;
+    stopWatching = watchViewer(label, showStats);
+  }
+
+  function setMode(value) {
+    mode = value === 'snapshots' ? 'snapshots' : 'live';
+    localStorage.setItem(MODE_KEY, mode);
+    modeSelect.value = mode;
+    suggest.hidden = true;
+    slowReports = 0;
+    stats.textContent = '';
+    start();
   }
 
   async function refreshTopics() {
@@ -73,18 +124,22 @@ if (card) {
     select.value = name;
     snapshotLink.href = at(`/snapshot?${query(name)}`);
     openLink.href = at(`/stream?${query(name)}`);
-    streaming = null;
+    stop();
     start();
   }
 
-  img.addEventListener('load', () => { if (streaming !== null) say(''); });
+  img.addEventListener('load', () => { if (streaming !== null && mode === 'live') say(''); });
   img.addEventListener('error', () => {
-    if (streaming === null) return;
+    if (streaming === null || mode !== 'live') return;
+    if (stopWatching) { stopWatching(); stopWatching = null; }
     streaming = null;  // the stream ended (server restarted, topic refused): look again shortly
     say(`the stream from ${topic} stopped; retrying`);
     recheckTimer = setTimeout(refreshTopics, RECHECK_MS);
   });
   select.addEventListener('change', () => choose(select.value));
+  modeSelect.value = mode;
+  modeSelect.addEventListener('change', () => setMode(modeSelect.value));
+  suggest.querySelector('button').addEventListener('click', () => setMode('snapshots'));
   select.addEventListener('focus', refreshTopics);
   document.addEventListener('visibilitychange', start);
 

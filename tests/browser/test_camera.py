@@ -83,3 +83,50 @@ def test_topic_page_lists_the_simulators_topics_and_echoes_one(live_server, sim_
     page.locator("#topics-body a[data-topic='/camera/image_raw']").click()
     page.wait_for_selector("#echo-stream:not([hidden])", timeout=15000)
     assert page.watch.offhost == [] and page.watch.console_errors == []
+
+
+STATS = r"/^\d+(\.\d)? fps · \d+×\d+ · \d+ kbit\/s/"
+
+
+def test_camera_card_shows_fps_size_and_kbps_and_a_snapshot_mode_it_remembers(live_server, sim_process, page):
+    sim_process()
+    page.goto(live_server.url + "/")
+    # The server's figures for this page's own stream (GET /api/camera/viewers?viewer=...).
+    page.wait_for_function(f"{STATS}.test(document.getElementById('camera-stats').textContent)", timeout=30000)
+    assert "640×480" in page.locator("#camera-stats").inner_text()
+    camera = live_server.rover.feature(CameraStreams)
+    [viewer] = camera.clients()
+    assert viewer["viewer"].startswith("card-") and viewer["width"] == 640
+
+    snapshots = []
+    page.on("request", lambda request: "/snapshot?" in request.url and snapshots.append(request.url))
+    page.select_option("#camera-mode", "snapshots")
+    page.wait_for_function("document.getElementById('camera-image').src.startsWith('blob:')", timeout=15000)
+    page.wait_for_function(f"{STATS}.test(document.getElementById('camera-stats').textContent)", timeout=15000)
+    deadline = time.monotonic() + 10
+    while camera.clients():  # the MJPEG stream is gone; only snapshots now
+        assert time.monotonic() < deadline, "the stream stayed open in snapshot mode"
+        page.wait_for_timeout(100)
+    page.wait_for_timeout(2500)
+    assert len(snapshots) >= 2 and all("width=640" in url for url in snapshots)
+    assert page.evaluate("() => document.getElementById('camera-image').naturalWidth") == 640
+
+    page.reload()  # remembered per browser
+    page.wait_for_function("document.getElementById('camera-image').src.startsWith('blob:')", timeout=15000)
+    assert page.locator("#camera-mode").input_value() == "snapshots"
+    assert camera.clients() == []
+    page.select_option("#camera-mode", "live")
+    page.wait_for_function("document.getElementById('camera-image').src.includes('/stream?')", timeout=15000)
+    assert page.watch.offhost == [] and page.watch.console_errors == []
+
+
+def test_a_very_slow_stream_suggests_snapshot_mode(live_server_factory, sim_process, page):
+    server = live_server_factory(ROVER_WEB_CAMERA_VIEWER_MAX_KBPS=8)  # 1 kB/s: about a frame a second at best
+    sim_process()
+    page.goto(server.url + "/")
+    page.wait_for_selector("#camera-suggest:not([hidden])", timeout=40000)
+    page.locator("#camera-suggest button").click()
+    page.wait_for_function("document.getElementById('camera-image').src.startsWith('blob:')", timeout=15000)
+    assert page.locator("#camera-mode").input_value() == "snapshots"
+    assert page.locator("#camera-suggest").is_hidden()
+    assert page.watch.offhost == [] and page.watch.console_errors == []

@@ -11,11 +11,12 @@ from tests.support.rospeer import ROOT, stop_piped, subprocess_env
 
 
 class ImagePublisher:
-    def __init__(self, topic: str, width: int = 320, height: int = 240, hz: float = 30.0, qos: str = "default"):
+    def __init__(self, topic: str, width: int = 320, height: int = 240, hz: float = 30.0, qos: str = "default",
+                 grain: int = 0):
         self.topic = topic
         self.proc = subprocess.Popen(
             [sys.executable, str(ROOT / "tests" / "support" / "peers" / "image_publisher.py"), "--topic", topic,
-             "--width", str(width), "--height", str(height), "--hz", str(hz), "--qos", qos],
+             "--width", str(width), "--height", str(height), "--hz", str(hz), "--qos", qos, "--grain", str(grain)],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=subprocess_env(), cwd=ROOT)
         line = self.proc.stdout.readline()
         if json.loads(line or "{}").get("event") != "ready":

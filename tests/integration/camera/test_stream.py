@@ -10,40 +10,10 @@ import requests
 from PIL import Image
 
 from rover_web.camera.service import CameraStreams
-from tests.support.camera_peer import ImagePublisher
-from tests.support.mjpeg import MjpegClient
 from tests.support.waiting import wait_until
 
 IMAGE = "sensor_msgs/msg/Image"
 COMPRESSED = "sensor_msgs/msg/CompressedImage"
-
-
-@pytest.fixture
-def image_publisher():
-    made = []
-
-    def make(topic, **kwargs):
-        publisher = ImagePublisher(topic, **kwargs)
-        made.append(publisher)
-        return publisher
-
-    yield make
-    for publisher in made:
-        publisher.close()
-
-
-@pytest.fixture
-def mjpeg_client():
-    made = []
-
-    def make(url, **kwargs):
-        client = MjpegClient(url, **kwargs)
-        made.append(client)
-        return client
-
-    yield make
-    for client in made:
-        client.close()
 
 
 def wait_listed(server, topic, timeout=15.0):

@@ -3,7 +3,9 @@
     python tests/peers/image_publisher.py --topic /cam --width 320 --height 240 --hz 30 [--qos sensor_data]
 
 Frame n has header.stamp = (n + 1, 0), so every frame is told apart by its stamp, and is filled
-with the colour (n mod 256, 100, 200) in rgb8. Stdout (JSON lines): {"event": "ready"}; each stdin
+with the colour (n mod 256, 100, 200) in rgb8; with --grain G, a fixed random grain of ±G is
+added, so its JPEGs are as large as a real camera's (rate-control tests need that).
+Stdout (JSON lines): {"event": "ready"}; each stdin
 line "status" is answered with {"event": "status", "published": n, "subscribers": k}; stdin EOF
 or "quit" stops it.
 """
@@ -23,10 +25,16 @@ from sensor_msgs.msg import Image
 from rover_web.ros import qos
 
 
-def frame_bytes(n: int, width: int, height: int) -> array.array:
+def frame_bytes(n: int, width: int, height: int, grain=None) -> array.array:
     pixel = bytes((n % 256, 100, 200))
     data = array.array("B")
-    data.frombytes(pixel * (width * height))
+    if grain is None:
+        data.frombytes(pixel * (width * height))
+    else:
+        import numpy as np
+
+        data.frombytes(np.clip(grain + np.frombuffer(pixel, np.uint8).astype(np.int16), 0, 255)
+                       .astype(np.uint8).tobytes())
     return data
 
 
@@ -37,7 +45,14 @@ def main() -> None:
     parser.add_argument("--height", type=int, default=240)
     parser.add_argument("--hz", type=float, default=30.0)
     parser.add_argument("--qos", default="default")
+    parser.add_argument("--grain", type=int, default=0)
     args = parser.parse_args()
+    grain = None
+    if args.grain:
+        import numpy as np
+
+        grain = np.random.default_rng(7).integers(-args.grain, args.grain + 1, (args.height, args.width, 3),
+                                                  dtype=np.int16)
 
     context = Context()
     rclpy.init(context=context, signal_handler_options=SignalHandlerOptions.NO)
@@ -51,7 +66,7 @@ def main() -> None:
         msg.header.stamp.sec = n + 1
         msg.header.frame_id = "test_camera"
         msg.width, msg.height, msg.encoding, msg.step = args.width, args.height, "rgb8", args.width * 3
-        msg.data = frame_bytes(n, args.width, args.height)
+        msg.data = frame_bytes(n, args.width, args.height, grain)
         pub.publish(msg)
         count[0] = n + 1
 

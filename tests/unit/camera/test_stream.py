@@ -265,3 +265,26 @@ def test_bad_stream_arguments(args, code):
     with pytest.raises(InvalidInput) as info:
         parse(**args)
     assert info.value.code == code
+
+
+def test_one_source_feeds_every_output_of_a_topic_with_one_numbering():
+    from rover_web.camera.stream import FrameSource, SourceKey
+
+    source = FrameSource(SourceKey("/cam", "sensor_msgs/msg/Image", "default"))
+    full = FrameProducer(KEY, CountingEncoder())
+    source.attach(full)
+    for n in range(1, 4):
+        source.put(n)
+    seq, jpeg = full.next_frame(0, 1.0)
+    assert (seq, jpeg.stamp) == (3, 3.0)
+    # A viewer stepping down to a smaller output keeps its place: the new output starts from the
+    # newest message (no wait for the next one), numbered as before, so it is not sent twice.
+    small = FrameProducer(KEY._replace(width=160, quality=40), CountingEncoder())
+    source.attach(small)
+    assert small.next_frame(0, 1.0)[0] == 3
+    assert small.next_frame(seq, 0.05) is None
+    source.put(4)
+    assert small.next_frame(seq, 1.0)[1].stamp == 4.0 and full.next_frame(seq, 1.0)[1].stamp == 4.0
+    small.put(2, 2)  # an older message never replaces a newer one
+    assert small.latest()[0] == 4
+    assert source.detach(small) == 1 and source.detach(full) == 0
