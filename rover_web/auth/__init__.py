@@ -69,4 +69,5 @@ def init_app(app: Flask, rover: Rover) -> None:
     def _identity_context():
         identity = current_identity()
         return {"signed_in": identity if service.required else None, "sign_in_on": service.required,
-                "can_operate": may("operator", service.required)}
+                "can_operate": may("operator", service.required),
+                "can_admin": may("admin", service.required)}  # the geofence editor (PUT /api/geofence)
