@@ -84,4 +84,5 @@ def init_app(app: Flask, rover: Rover) -> None:
         identity = current_identity()
         sign_in_on = service.sign_in_on()
         return {"signed_in": identity if sign_in_on else None, "sign_in_on": sign_in_on,
-                "can_operate": may("operator", sign_in_on)}
+                "can_operate": may("operator", sign_in_on),
+                "can_admin": may("admin", sign_in_on)}  # the geofence editor (PUT /api/geofence)

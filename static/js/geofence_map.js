@@ -2,7 +2,9 @@
 // (draw a polygon, drag its vertices, delete it, import a GeoJSON file). Built on MapLibre's own
 // GeoJSON sources, layers and draggable markers: no drawing library to vendor, and the server
 // stays the judge — every edit is a local draft until "Save fence" PUTs it to /api/geofence,
-// whose refusal (400 with the feature named) is shown as it is.
+// whose refusal (400 with the feature named, 403 below admin) is shown as it is. Below admin the
+// page renders the editor's fieldset disabled with the reason (templates/panels/waypoints.html);
+// a role lowered after the page loaded still meets the server's 403, in the server's words.
 import { api } from './api.js';
 import { on } from './live.js';
 
@@ -148,7 +150,7 @@ export function attachGeofence(map) {
   // --- editing ---
 
   function handleClick(e) {
-    if (!editing()) return false;
+    if (box.disabled || !editing()) return false;
     const { lng, lat } = e.lngLat.wrap();
     if (drawing) {
       drawing.points.push([lng, lat]);

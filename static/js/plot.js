@@ -26,6 +26,24 @@ function showError(err) {
   el.hidden = false;
 }
 
+// A type the server will not plot (422 not_plottable: images, point clouds, maps) is said beside
+// the field chooser, in the server's words, for as long as that topic is chosen.
+function showRefusal(err) {
+  const el = $('plot-refusal');
+  const refused = err instanceof ApiError && err.status === 422;
+  el.textContent = refused ? err.message : '';
+  el.dataset.code = refused ? err.code || '' : '';
+  el.hidden = !refused;
+  if (refused) fieldInput.setAttribute('aria-describedby', 'plot-refusal');
+  else fieldInput.removeAttribute('aria-describedby');
+  fieldInput.setAttribute('aria-invalid', String(refused));
+  return refused;
+}
+
+function showFailure(err) {
+  if (showRefusal(err)) showError(null); else showError(err);
+}
+
 const windowS = () => Number($('plot-window').value);
 
 function tables(since) {
@@ -136,12 +154,13 @@ $('plot-csv').addEventListener('click', () => {
 
 async function loadFields() {
   $('plot-fields').replaceChildren();
+  showRefusal(null);
   if (!topicSelect.value) return;
   try {
     const reply = await api('GET', `/api/plot/fields?${new URLSearchParams({ topic: topicSelect.value })}`);
     $('plot-fields').replaceChildren(...reply.fields.map((f) => Object.assign(document.createElement('option'), { value: f })));
     showError(null);
-  } catch (err) { showError(err); }
+  } catch (err) { showFailure(err); }
 }
 
 topicSelect.addEventListener('change', loadFields);
@@ -150,7 +169,7 @@ $('plot-form').addEventListener('submit', async (e) => {
   const topic = topicSelect.value;
   const field = fieldInput.value.trim();
   if (!topic || !field) { showError(new ApiError(400, 'missing', 'choose a topic and a field')); return; }
-  try { await add(topic, field); showError(null); } catch (err) { showError(err); }
+  try { await add(topic, field); showFailure(null); } catch (err) { showFailure(err); }
 });
 pauseButton.addEventListener('click', () => setPaused(!paused));
 $('plot-window').addEventListener('change', () => { if (!paused) rebuild(); });
@@ -178,5 +197,5 @@ window.addEventListener('resize', () => { if (chart) chart.setSize({ width: Math
 const params = new URLSearchParams(location.search);
 for (const field of params.getAll('field')) {
   const topic = params.get('topic');
-  if (topic) add(topic, field).catch(showError);
+  if (topic) add(topic, field).catch(showFailure);
 }

@@ -1,20 +1,26 @@
 """The geofence on the GPS map in a real Chromium: draw a keep-in area and save it, a click outside it
-is refused with the server's message, vertices move, areas are deleted, and a file imports."""
+is refused with the server's message, vertices move, areas are deleted, and a file imports. With
+sign-in on, an operator sees the editor disabled with the reason; an admin edits and saves, and a
+save after the admin's role was lowered shows the server's 403."""
 
 import json
 
 import pytest
 import requests
 
+from rover_web.auth import AuthService
+from tests.browser.test_auth import sign_in
 from tests.browser.test_waypoints_map import open_map, unproject, wait_until
+from tests.support.auth import add_users
 from tests.support.geofence_helpers import FENCE
 from tests.support.waypoint_helpers import stored_rows
 
 pytestmark = pytest.mark.browser
 
 
-def fence(url):
-    return requests.get(url + "/api/geofence", timeout=5).json()
+def fence(url, token=None):
+    headers = {"Authorization": f"Bearer {token}"} if token else {}
+    return requests.get(url + "/api/geofence", headers=headers, timeout=5).json()
 
 
 def test_draw_a_fence_then_a_click_outside_it_is_refused_visibly(live_server_factory, page, tmp_path):
@@ -98,6 +104,72 @@ def test_draw_a_fence_then_a_click_outside_it_is_refused_visibly(live_server_fac
     page.wait_for_selector("#gf-message[data-kind='error']")
     assert "bowtie" in page.locator("#gf-message").inner_text()
     assert fence(server.url)["revision"] == 4
+    assert page.watch.offhost == []
+
+
+def signed_map_server(live_server_factory, tmp_path):
+    db_path = tmp_path / "signed.sqlite3"
+    tokens = add_users(db_path)
+    server = live_server_factory(ROVER_WEB_AUTH="required", ROVER_WEB_DB_PATH=str(db_path),
+                                 ROVER_WEB_MAP_TILES=str(tmp_path / "no-basemap"))
+    server.tokens = tokens
+    return server
+
+
+EDIT_CONTROLS = ["#gf-edit", "#gf-draw-in", "#gf-draw-out", "#gf-finish", "#gf-delete", "#gf-save", "#gf-revert",
+                 "#gf-import"]
+
+
+def test_an_operator_sees_the_fence_editor_disabled_with_the_reason(live_server_factory, page, tmp_path):
+    server = signed_map_server(live_server_factory, tmp_path)
+    sign_in(page, server.url, "operator")
+    open_map(page, server.url)
+    page.wait_for_selector("#gf-editor[data-ready='yes']")
+    assert page.locator("#gf-editor").get_attribute("data-may-edit") == "no"
+    assert page.locator("#gf-admin-only").is_visible()
+    assert page.locator("#gf-admin-only").inner_text() == "Only an admin may change the geofence."
+    for control in EDIT_CONTROLS:
+        assert page.locator(control).is_disabled(), control
+    # The operator's other work is untouched: a map click still adds a waypoint.
+    box = page.locator("#wp-map").bounding_box()
+    page.mouse.click(box["x"] + box["width"] * 0.5, box["y"] + box["height"] * 0.5)
+    page.wait_for_selector(".wp-marker")
+    assert fence(server.url, server.tokens["operator"])["revision"] == 0
+    assert page.watch.offhost == []
+
+
+def test_an_admin_edits_and_saves_and_a_lowered_role_meets_the_servers_403(live_server_factory, page, tmp_path):
+    server = signed_map_server(live_server_factory, tmp_path)
+    sign_in(page, server.url, "admin")
+    open_map(page, server.url)
+    page.wait_for_selector("#gf-editor[data-ready='yes']")
+    assert page.locator("#gf-editor").get_attribute("data-may-edit") == "yes"
+    assert page.locator("#gf-admin-only").count() == 0
+    assert page.locator("#gf-edit").is_enabled() and page.locator("#gf-import").is_enabled()
+    box = page.locator("#wp-map").bounding_box()
+
+    def at(fx, fy):
+        return box["x"] + box["width"] * fx, box["y"] + box["height"] * fy
+
+    page.locator("#gf-edit").check()
+    page.locator("#gf-draw-out").click()
+    for c in [at(0.3, 0.3), at(0.6, 0.3), at(0.6, 0.7), at(0.3, 0.7)]:
+        page.mouse.click(*c)
+    page.locator("#gf-finish").click()
+    page.locator("#gf-save").click()
+    page.wait_for_selector("#gf-editor[data-revision='1']")
+    assert fence(server.url, server.tokens["viewer"])["features"][0]["properties"] == {"kind": "keep_out"}
+
+    # The admin becomes an operator while the page is open: the page still offers the editor, and
+    # the server's refusal is what the operator reads. Nothing changes.
+    server.rover.feature(AuthService).accounts.set_role("admin", "operator")
+    page.mouse.click(*at(0.45, 0.5))  # select the area
+    page.locator("#gf-delete").click()
+    page.locator("#gf-save").click()
+    page.wait_for_selector("#gf-message[data-kind='error']")
+    shown = page.locator("#gf-message").inner_text()
+    assert shown.startswith("Fence not saved: ") and "admin" in shown
+    assert fence(server.url, server.tokens["viewer"])["revision"] == 1
     assert page.watch.offhost == []
 
 

@@ -1,10 +1,14 @@
 """Logs, diagnostics and plots in Chromium: the logs page filters and pauses, the plot page draws a series
-from the simulator and exports it as CSV, the dashboard shows diagnostics and the link plot."""
+from the simulator and exports it as CSV and says beside the field chooser why a camera's images are
+not plotted, the dashboard shows diagnostics and the link plot."""
 
 import csv
 import io
 
 import pytest
+import requests
+
+from tests.support.camera_peer import ImagePublisher
 
 pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
@@ -94,6 +98,47 @@ def test_the_plot_page_draws_a_simulator_series_and_exports_csv(live_server, sim
     # The one refused field is the browser's only complaint.
     assert [e for e in page.watch.console_errors if "status of 400" not in e] == []
     assert page.watch.offhost == []
+
+
+def test_the_plot_page_says_beside_the_field_why_an_image_topic_is_not_plotted(live_server, page):
+    topic = "/test/plot_camera"
+    camera = ImagePublisher(topic, width=32, height=24, hz=5)
+    try:
+        page.goto(live_server.url + "/plot")
+        page.wait_for_selector("#link-server[data-state='live']", timeout=10000)
+        page.wait_for_selector(f"#plot-topic option[value='{topic}']", state="attached", timeout=15000)
+        assert page.locator("#plot-refusal").is_hidden()
+        page.select_option("#plot-topic", topic)
+        page.wait_for_selector("#plot-refusal:not([hidden])", timeout=10000)
+        # The server's own words (its 422), beside the field, not a generic failure below the form.
+        reply = requests.get(live_server.url + "/api/plot/fields", params={"topic": topic}, timeout=5)
+        assert reply.status_code == 422 and reply.json()["error"] == "not_plottable"
+        assert page.inner_text("#plot-refusal") == reply.json()["message"]
+        assert "sensor_msgs/msg/Image" in page.inner_text("#plot-refusal")
+        assert page.get_attribute("#plot-refusal", "data-code") == "not_plottable"
+        assert page.get_attribute("#plot-field", "aria-invalid") == "true"
+        assert page.locator("#plot-error").is_hidden()
+        near = page.evaluate("""() => {
+            const a = document.getElementById('plot-field').getBoundingClientRect();
+            const b = document.getElementById('plot-refusal').getBoundingClientRect();
+            return Math.abs((a.top + a.bottom) / 2 - (b.top + b.bottom) / 2) < 2 * a.height;
+        }""")
+        assert near  # on the field's row, not somewhere else on the page
+        # Adding a field anyway meets the same refusal there, and no series starts.
+        page.fill("#plot-field", "height")
+        page.evaluate("document.getElementById('plot-refusal').hidden = true")
+        page.click("#plot-add")
+        page.wait_for_selector("#plot-refusal:not([hidden])", timeout=10000)
+        assert "not numbers to plot" in page.inner_text("#plot-refusal")
+        assert page.locator("#plot-series li").count() == 0
+        # Choosing no topic clears it.
+        page.select_option("#plot-topic", "")
+        page.wait_for_selector("#plot-refusal", state="hidden", timeout=5000)
+        assert page.get_attribute("#plot-field", "aria-invalid") == "false"
+        assert [e for e in page.watch.console_errors if "status of 422" not in e] == []
+        assert page.watch.offhost == []
+    finally:
+        camera.close()
 
 
 def test_the_dashboard_shows_diagnostics_and_the_link_plot(live_server, sim_process, page):
