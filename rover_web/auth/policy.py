@@ -23,7 +23,10 @@ READ_METHODS = frozenset({"GET", "HEAD", "OPTIONS"})
 PUBLIC_ENDPOINTS = frozenset({"auth.login_form", "auth.login", "static"})
 # Any signed-in user, whatever the method.
 # estop_set: the view checks release; estop_all only engages: whoever may watch may stop every robot.
-ANY_USER_ENDPOINTS = frozenset({"auth.logout", "estop.estop_set", "estop.estop_all"})
+# The WHEP offer and its DELETE only watch the camera; the teleop data channel in a WHEP session is
+# refused unless its user was an operator when the session was made (camera/webrtc/service.py).
+ANY_USER_ENDPOINTS = frozenset({"auth.logout", "estop.estop_set", "estop.estop_all",
+                                "camera_webrtc.whep_offer", "camera_webrtc.whep_end"})
 ADMIN_ENDPOINT_PREFIX = "auth.admin_"
 
 
