@@ -46,6 +46,7 @@ class WhepClient:
         self.channel = None
         self.channel_open = threading.Event()
         self.channel_closed = threading.Event()
+        self._cond = threading.Condition()
         self.pc = None
         self.location = None
         self._reader = None
@@ -70,8 +71,8 @@ class WhepClient:
             if teleop:
                 self.channel = pc.createDataChannel("teleop", ordered=False, maxRetransmits=0)
                 self.channel.on("open", self.channel_open.set)
-                self.channel.on("close", self.channel_closed.set)
-                self.channel.on("message", lambda m: self.messages.append(json.loads(m)))
+                self.channel.on("close", self._channel_closed)
+                self.channel.on("message", self._on_message)
 
             @pc.on("track")
             def _track(track) -> None:
@@ -79,6 +80,18 @@ class WhepClient:
 
             await pc.setLocalDescription(await pc.createOffer())
         return filter_candidates(pc.localDescription.sdp, LOOPBACK)
+
+    def _channel_closed(self) -> None:
+        self.channel_closed.set()
+        with self._cond:
+            self._cond.notify_all()
+
+    def _on_message(self, text) -> None:
+        message = json.loads(text)
+        message["t"] = time.monotonic()
+        with self._cond:
+            self.messages.append(message)
+            self._cond.notify_all()
 
     async def _read(self, track) -> None:
         while True:
@@ -120,3 +133,64 @@ class WhepClient:
             except Exception:
                 pass
         self.loop.stop()
+
+
+class ChannelTeleop:
+    """The `teleop` data channel of a WhepClient with tests/support/teleop_support.TeleopClient's
+    interface, so one test body drives over either transport."""
+
+    def __init__(self, client: WhepClient, timeout_s: float = 15.0):
+        self.client = client
+        if not client.channel_open.wait(timeout_s):
+            raise TimeoutError("the teleop data channel did not open")
+        self.closed = client.channel_closed
+        self.hello = self.wait_for(lambda m: m["type"] in ("hello", "error"))
+
+    @property
+    def messages(self) -> list[dict]:
+        with self.client._cond:
+            return list(self.client.messages)
+
+    @property
+    def epoch(self) -> int:
+        for message in reversed(self.messages):
+            if message["type"] in ("hello", "state"):
+                return message["epoch"]
+        return 0
+
+    def send(self, frame) -> None:
+        self.client.send(frame if isinstance(frame, str) else json.dumps(frame, allow_nan=True))
+
+    def drive(self, linear: float, angular: float = 0.0, epoch: int | None = None, **extra) -> float:
+        frame = {"linear": linear, "angular": angular, "epoch": self.epoch if epoch is None else epoch, **extra}
+        t = time.monotonic()
+        self.send(frame)
+        return t
+
+    def wait_for(self, predicate, timeout: float = 10.0) -> dict:
+        deadline = time.monotonic() + timeout
+        seen = 0
+        cond = self.client._cond
+        with cond:
+            while True:
+                messages = list(self.client.messages)
+                for message in messages[seen:]:
+                    if predicate(message):
+                        return message
+                seen = len(messages)
+                remaining = deadline - time.monotonic()
+                if remaining <= 0 or self.closed.is_set():
+                    raise TimeoutError(f"no matching message within {timeout} s: {messages[-5:]}")
+                cond.wait(remaining)
+
+    def errors(self, code: str | None = None) -> list[dict]:
+        return [m for m in self.messages if m["type"] == "error" and (code is None or m["error"] == code)]
+
+    def wait_errors(self, count: int, timeout: float = 5.0) -> list[dict]:
+        with self.client._cond:
+            if not self.client._cond.wait_for(lambda: len(self.errors()) >= count, timeout):
+                raise TimeoutError(f"{len(self.errors())} error frames, expected {count}")
+        return self.errors()
+
+    def close(self) -> None:
+        self.client.close()

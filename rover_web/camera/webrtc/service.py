@@ -28,7 +28,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from aiortc import RTCConfiguration, RTCIceServer, RTCPeerConnection, RTCSessionDescription
+from aiortc.rtcdtlstransport import X509_DIGEST_ALGORITHMS
 from aiortc.rtp import RTCP_PSFB_APP, RtcpPsfbPacket, unpack_remb_fci
+from aiortc.sdp import SessionDescription
 
 from rover_web.camera import msgs as camera_msgs
 from rover_web.camera.service import CameraStreams, CannotSubscribe, Unavailable
@@ -98,6 +100,15 @@ class WhepSession:
                 "target_bps": self.encoder_bitrate(), "remb_bps": self.remb_bps,
                 "teleop": self.teleop is not None and not self.teleop.closed,
                 "age_s": round(time.monotonic() - self.created, 1)}
+
+
+def _check_fingerprints(offer: str) -> None:
+    """aiortc takes an offer whose DTLS fingerprints it cannot check, then fails the handshake
+    later; say so now, as a 400."""
+    for media in SessionDescription.parse(offer).media:
+        if not any(f.algorithm in X509_DIGEST_ALGORITHMS for f in media.dtls.fingerprints):
+            raise InvalidInput(f"the offer's {media.kind} section has no DTLS fingerprint this server can check "
+                               f"({', '.join(X509_DIGEST_ALGORITHMS)})", "bad_sdp")
 
 
 def tap_remb(session: WhepSession) -> None:
@@ -304,6 +315,7 @@ class WebRtcService:
             except Exception as exc:  # aiortc raises ValueError, KeyError, IndexError... for bad SDP
                 raise InvalidInput(f"the SDP offer could not be used: {str(exc)[:200] or type(exc).__name__}",
                                    "bad_sdp") from None
+            _check_fingerprints(offer)
             video = [t for t in pc.getTransceivers() if t.kind == "video"]
             if not video or video[0].direction not in ("recvonly", "sendrecv"):
                 raise NoVideo("the offer's video section must be recvonly (or sendrecv)", "no_video")
