@@ -94,7 +94,8 @@ def test_bad_offers_get_4xx_json_and_leak_nothing(webrtc_server, camera, whep, r
     url = server.url + "/api/camera/whep"
     sdp = {"Content-Type": "application/sdp"}
     cases = [
-        (url + f"?topic=/cam&{IMAGE}", "v=0\r\no=- 0 0 IN IP4 127.0.0.1\r\nm=video x\r\nthis is not sdp\r\n", sdp, 400, "bad_sdp"),
+        (url + f"?topic=/cam&{IMAGE}", "v=0\r\no=- 0 0 IN IP4 127.0.0.1\r\nm=video x\r\nthis is not sdp\r\n", sdp,
+         400, "bad_sdp"),
         (url + f"?topic=/cam&{IMAGE}", "hello", sdp, 400, "bad_sdp"),
         (url + f"?topic=/cam&{IMAGE}", offer, {"Content-Type": "application/json"}, 415, "unsupported_media_type"),
         (url + f"?topic=/cam&{IMAGE}", offer, {"Content-Type": "text/plain"}, 415, "unsupported_media_type"),
@@ -212,8 +213,9 @@ def test_whep_needs_the_viewer_role(signed_server, camera, whep, caller, status)
     headers = {"Authorization": f"Bearer {signed_server.tokens[caller]}"} if caller else {}
     if status == 201:
         client = whep(signed_server.url, f"topic=/cam&{IMAGE}", headers=headers)
+        someone = "admin" if caller == "viewer" else "viewer"
         other = requests.delete(signed_server.url + client.location, timeout=5,
-                                headers={"Authorization": f"Bearer {signed_server.tokens['admin' if caller == 'viewer' else 'viewer']}"})
+                                headers={"Authorization": f"Bearer {signed_server.tokens[someone]}"})
         # An admin may end anyone's session; a viewer may not end an operator's.
         assert other.status_code == (204 if caller == "viewer" else 404)
         return
