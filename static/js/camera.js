@@ -3,6 +3,7 @@
 // for topics the ROS graph lists as images, so a missing camera is a message, not a failed request.
 
 import { api, at } from './api.js';
+import { play as playWebRtc, stop as stopWebRtc } from './camera/webrtc.js';
 
 const card = document.getElementById('camera-card');
 const STORAGE_KEY = 'rover_web.camera.topic';
@@ -34,6 +35,7 @@ if (card) {
   }
 
   function stop() {
+    stopWebRtc();
     if (streaming === null) return;
     streaming = null;
     img.src = BLANK;  // ends the MJPEG request; the server releases the stream
@@ -48,6 +50,13 @@ if (card) {
       recheckTimer = setTimeout(refreshTopics, RECHECK_MS);
       return;
     }
+    if (playWebRtc(topic, start)) {  // WebRTC first; it calls start() again if it falls back
+      if (streaming !== null) { streaming = null; img.src = BLANK; }
+      img.hidden = true;
+      say('');
+      return;
+    }
+    img.hidden = false;
     const url = at(`/stream?${query(topic)}&width=640`);
     if (streaming === url) return;
     streaming = url;
@@ -85,6 +94,7 @@ if (card) {
     recheckTimer = setTimeout(refreshTopics, RECHECK_MS);
   });
   select.addEventListener('change', () => choose(select.value));
+  card.addEventListener('camera:transport', () => { streaming = null; start(); });
   select.addEventListener('focus', refreshTopics);
   document.addEventListener('visibilitychange', start);
 

@@ -14,6 +14,7 @@ come from the settings only (ice.py). See docs/camera.md.
 from __future__ import annotations
 
 from rover_web.core.fleet import Fleet
+from rover_web.core.state import current_feature
 
 from . import routes
 from .loop import LoopThread
@@ -33,3 +34,4 @@ def init_app(app, fleet: Fleet, camera_of) -> None:
         service.start()
         rover.on_shutdown(service.close)
     app.register_blueprint(routes.bp)
+    app.jinja_env.globals["webrtc_panel"] = lambda: {"enabled": current_feature(WebRtcService).max_viewers > 0}

@@ -32,6 +32,8 @@ from aiortc.rtcdtlstransport import X509_DIGEST_ALGORITHMS
 from aiortc.rtp import RTCP_PSFB_APP, RtcpPsfbPacket, unpack_remb_fci
 from aiortc.sdp import SessionDescription
 
+from rover_web import process
+from rover_web.auth.policy import is_loopback
 from rover_web.camera import msgs as camera_msgs
 from rover_web.camera.service import CameraStreams, CannotSubscribe, Unavailable
 from rover_web.camera.stream import FrameProducer, StreamKey
@@ -43,7 +45,7 @@ from rover_web.web.validate import InvalidInput
 
 from . import frames
 from .adapt import AdaptPolicy
-from .ice import check_addresses, filter_candidates, only_host_addresses, parse_ice_server
+from .ice import candidate_address, check_addresses, filter_candidates, only_host_addresses, parse_ice_server
 from .loop import LoopStopped, LoopThread
 from .track import CameraTrack
 
@@ -102,6 +104,31 @@ class WhepSession:
                 "age_s": round(time.monotonic() - self.created, 1)}
 
 
+def host_addresses(config) -> tuple[str, ...]:
+    """The setting's addresses; when it is empty and the server listens on loopback only, 127.0.0.1
+    (nobody elsewhere can reach the page, so no other address is worth offering: the tests rely on
+    this); else () for every interface's."""
+    try:
+        chosen = check_addresses(config["ROVER_WEB_WEBRTC_HOST_ADDRESSES"])
+    except ValueError as exc:
+        raise ConfigError(f"ROVER_WEB_WEBRTC_HOST_ADDRESSES: {exc}") from None
+    if chosen:
+        return chosen
+    listening = process.listen_hosts(config)
+    if listening and all(is_loopback(h) for h in listening):
+        return ("127.0.0.1",)
+    return ()
+
+
+def _without_mdns(offer: str) -> str:
+    """Drop the offer's mDNS (`.local`) candidates: resolving them would send multicast queries on
+    every interface. A browser behind one is found anyway, from its connectivity checks (a
+    peer-reflexive candidate)."""
+    lines = offer.split("\n")
+    kept = [line for line in lines if not ((found := candidate_address(line)) and found[0].endswith(".local"))]
+    return "\n".join(kept)
+
+
 def _check_fingerprints(offer: str) -> None:
     """aiortc takes an offer whose DTLS fingerprints it cannot check, then fails the handshake
     later; say so now, as a 400."""
@@ -138,10 +165,7 @@ class WebRtcService:
         self.max_viewers = config["ROVER_WEB_WEBRTC_MAX_VIEWERS"]
         self.idle_timeout_s = config["ROVER_WEB_WEBRTC_IDLE_TIMEOUT_S"]
         self.max_fps = config["ROVER_WEB_WEBRTC_MAX_FPS"]
-        try:
-            self.host_addresses = check_addresses(config["ROVER_WEB_WEBRTC_HOST_ADDRESSES"])
-        except ValueError as exc:
-            raise ConfigError(f"ROVER_WEB_WEBRTC_HOST_ADDRESSES: {exc}") from None
+        self.host_addresses = host_addresses(config)
         try:
             self.ice_servers = [parse_ice_server(s) for s in config["ROVER_WEB_WEBRTC_ICE_SERVERS"]]
         except ValueError as exc:
@@ -311,7 +335,7 @@ class WebRtcService:
                 self._on_datachannel(session, channel)
 
             try:
-                await pc.setRemoteDescription(RTCSessionDescription(sdp=offer, type="offer"))
+                await pc.setRemoteDescription(RTCSessionDescription(sdp=_without_mdns(offer), type="offer"))
             except Exception as exc:  # aiortc raises ValueError, KeyError, IndexError... for bad SDP
                 raise InvalidInput(f"the SDP offer could not be used: {str(exc)[:200] or type(exc).__name__}",
                                    "bad_sdp") from None
