@@ -199,8 +199,33 @@ def test_the_drive_card_can_use_the_teleop_channel(live_server, sim_process, web
       while (!seen.some((m) => m.type === 'state' && m.reason === 'in_control') && Date.now() < deadline) {
         await new Promise((r) => setTimeout(r, 50));
       }
-      return { open: teleopChannel.isOpen(), seen };
+      // The WebSocket look-alike the Drive card can take instead of its socket: hello first, up to date.
+      const sock = teleopChannel.socket();
+      const first = await new Promise((resolve) => { sock.onmessage = (e) => resolve(JSON.parse(e.data)); });
+      sock.send(JSON.stringify({ linear: 0.2, angular: 0, epoch: first.epoch }));
+      const closed = new Promise((resolve) => { sock.onclose = () => resolve(true); });
+      sock.close();
+      return { open: teleopChannel.isOpen(), seen, first, closed: await closed, stillOpen: teleopChannel.isOpen() };
     }""")
     assert got["open"] and any(m["type"] == "state" and m["reason"] == "in_control" for m in got["seen"])
+    assert got["first"]["type"] == "hello" and got["first"]["in_control"] is True
+    assert got["first"]["transport"] == "datachannel"
+    assert got["closed"] and got["stillOpen"]  # closing the look-alike leaves the camera's channel open
+    wait_until(lambda: requests.get(live_server.url + "/api/teleop", timeout=5).json()["linear_mps"] == 1.0, 10,
+               "the look-alike's drive frame reached the robot")
     holder = requests.get(live_server.url + "/api/teleop", timeout=5).json()["holder"]
     assert holder is not None
+
+
+def test_a_hidden_tab_ends_its_webrtc_session(live_server, sim_process, webrtc_page):
+    sim_process()
+    page = webrtc_page
+    page.goto(live_server.url + "/")
+    page.wait_for_selector("#camera-card[data-transport-in-use='webrtc']", timeout=30000)
+    page.evaluate("() => { Object.defineProperty(document, 'hidden', {value: true, configurable: true});"
+                  " document.dispatchEvent(new Event('visibilitychange')); }")
+    wait_until(lambda: not live_server.rover.feature(WebRtcService).sessions(), 20, "the session ended")
+    page.evaluate("() => { Object.defineProperty(document, 'hidden', {value: false, configurable: true});"
+                  " document.dispatchEvent(new Event('visibilitychange')); }")
+    wait_until(lambda: live_server.rover.feature(WebRtcService).sessions(), 30, "a new session when shown")
+    page.wait_for_selector("#camera-card[data-transport-in-use='webrtc']", timeout=30000)

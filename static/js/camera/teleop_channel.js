@@ -8,8 +8,15 @@
 //   teleopChannel.send(obj)           false when not open (send over the WebSocket then)
 //   teleopChannel.onMessage(fn)       fn(message) for every frame the server sends (hello, state, error)
 //   teleopChannel.onChange(fn)        fn(isOpen) when the channel opens or closes
+//   teleopChannel.socket()            a WebSocket look-alike on the channel (readyState, send, close,
+//                                     onmessage, onclose) whose first message is the channel
+//                                     session's hello, brought up to date: code written for the
+//                                     socket takes it unchanged
 
+const OPEN = 1;
+const CLOSED = 3;
 const messageListeners = new Set();
+let hello = null;  // the channel session's hello, with the latest state frame's fields applied
 const changeListeners = new Set();
 let channel = null;
 
@@ -26,6 +33,7 @@ export const teleopChannel = {
   },
   onMessage(fn) { messageListeners.add(fn); return () => messageListeners.delete(fn); },
   onChange(fn) { changeListeners.add(fn); return () => changeListeners.delete(fn); },
+  socket() { return this.isOpen() ? socketOn(channel) : null; },
 };
 
 // Called by camera/webrtc.js with the channel it created (null when its session ends).
@@ -38,8 +46,33 @@ export function attachTeleopChannel(dc) {
     dc.addEventListener('message', (ev) => {
       let m;
       try { m = JSON.parse(ev.data); } catch { return; }
+      if (m.type === 'hello') hello = m;
+      else if (m.type === 'state' && hello) hello = { ...hello, ...m, type: 'hello' };
       for (const fn of messageListeners) { try { fn(m); } catch { /* see above */ } }
     });
+  } else {
+    hello = null;
   }
   changed();
+}
+
+function socketOn(dc) {
+  const sock = {
+    readyState: OPEN, onmessage: null, onclose: null,
+    send(text) { if (sock.readyState === OPEN) dc.send(text); },
+    close() { end(); },
+  };
+  const forward = (m) => { if (sock.readyState === OPEN && sock.onmessage) sock.onmessage({ data: JSON.stringify(m) }); };
+  const offMessage = teleopChannel.onMessage(forward);
+  const offChange = teleopChannel.onChange((open) => { if (!open) end(); });
+  function end() {
+    if (sock.readyState === CLOSED) return;
+    sock.readyState = CLOSED;
+    offMessage();
+    offChange();
+    setTimeout(() => { if (sock.onclose) sock.onclose({ code: 1000 }); }, 0);
+  }
+  // As a WebSocket would: the hello comes first, after the caller has set its handlers.
+  setTimeout(() => { if (hello) forward(hello); }, 0);
+  return sock;
 }

@@ -11,7 +11,7 @@ import { at } from '../api.js';
 import { attachTeleopChannel } from './teleop_channel.js';
 
 const STORAGE_KEY = 'rover_web.camera.transport';
-const CONNECT_TIMEOUT_MS = 5000;
+const CONNECT_TIMEOUT_MS = 6000;
 const GATHER_TIMEOUT_MS = 2000;
 const STATS_MS = 1000;
 
