@@ -85,13 +85,13 @@ def candidates(sdp: str) -> list[tuple[str, str]]:
     return [found for line in sdp.splitlines() if (found := candidate_address(line))]
 
 
-_ICE_URL = re.compile(r"^(stun|stuns|turn|turns):(?:(?P<user>[^:@/]+):(?P<secret>[^@/]+)@)?(?P<rest>[^@/\s]+)$")
+_ICE_URL = re.compile(r"(stun|stuns|turn|turns):(?:(?P<user>[^:@/]+):(?P<secret>[^@/]+)@)?(?P<rest>[^@/\s]+)")
 
 
 def parse_ice_server(text: str) -> dict:
     """A setting entry `stun:host:port` or `turn:user:secret@host:port[?transport=udp]` as
     RTCIceServer arguments; ValueError for anything else."""
-    match = _ICE_URL.match(text.strip())
+    match = _ICE_URL.fullmatch(text.strip())
     if not match:
         raise ValueError(f"{text[:80]!r} is not an ICE server: use stun:host:port or turn:user:secret@host:port")
     url = f"{match.group(1)}:{match.group('rest')}"
