@@ -167,6 +167,7 @@ def run(server: Server, viewers: int, seconds: float) -> dict:
     return {"viewers": viewers, "fps_median": statistics.median(fps), "fps_min": min(fps),
             "kbps_median": statistics.median(kbps), "cpu_pct": cpu, "cpu_per_viewer": cpu / viewers,
             "age_ms": (1000 * statistics.median(ages), 1000 * percentile(ages, 99)) if ages else None,
+            "source_hz": statistics.median([s["source_hz"] or 0 for s in sessions]),
             "levels": sorted({s["level"] for s in sessions if s["level"] is not None}),
             "sizes": sorted({f"{s['width']}x{s['height']}@{s['fps']:g}" for s in sessions if s["width"]}),
             "rss_mb": server.rss_mb()}
@@ -200,7 +201,8 @@ def main() -> None:
                   f"kbit/s/viewer {r['kbps_median']:6.0f}  server CPU {r['cpu_pct']:5.1f}% of one core "
                   f"({r['cpu_per_viewer']:4.1f}% per viewer)  glass-to-glass "
                   + (f"median {age[0]:5.1f} ms p99 {age[1]:5.1f} ms" if age else "n/a")
-                  + f"  level {r['levels']} {r['sizes']}  RSS {r['rss_mb']:.0f} MB", flush=True)
+                  + f"  camera arrivals {r['source_hz']:.1f}/s  level {r['levels']} {r['sizes']}"
+                  f"  RSS {r['rss_mb']:.0f} MB", flush=True)
     finally:
         if server is not None:
             server.stop()

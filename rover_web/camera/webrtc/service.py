@@ -101,6 +101,7 @@ class WhepSession:
                 "height": out.height if out else None, "fps": out.fps if out else None,
                 "target_bps": self.encoder_bitrate(), "remb_bps": self.remb_bps,
                 "teleop": self.teleop is not None and not self.teleop.closed,
+                "source_hz": self.producer.arrivals.snapshot(stale_after_s=2.0)["rate_hz"] if self.producer else None,
                 "age_s": round(time.monotonic() - self.created, 1)}
 
 
