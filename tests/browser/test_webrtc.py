@@ -229,3 +229,22 @@ def test_a_hidden_tab_ends_its_webrtc_session(live_server, sim_process, webrtc_p
                   " document.dispatchEvent(new Event('visibilitychange')); }")
     wait_until(lambda: live_server.rover.feature(WebRtcService).sessions(), 30, "a new session when shown")
     page.wait_for_selector("#camera-card[data-transport-in-use='webrtc']", timeout=30000)
+
+
+def test_the_drive_card_drives_over_the_data_channel_and_back_on_the_websocket(live_server, sim_process,
+                                                                                 webrtc_page):
+    sim_process()
+    page = webrtc_page
+    page.goto(live_server.url + "/")
+    page.wait_for_selector("#teleop-link[data-transport='datachannel']", timeout=30000)
+    assert "data channel" in page.locator("#teleop-link").inner_text()
+    page.locator("body").click(position={"x": 5, "y": 5})
+    page.keyboard.down("KeyW")
+    wait_until(lambda: requests.get(live_server.url + "/api/teleop", timeout=5).json()["linear_mps"] > 0, 10,
+               "the Drive card drives over the data channel")
+    page.keyboard.up("KeyW")
+    wait_until(lambda: requests.get(live_server.url + "/api/teleop", timeout=5).json()["linear_mps"] == 0, 10,
+               "and stops")
+    page.select_option("#camera-transport", "mjpeg")  # the peer connection goes: the WebSocket again
+    page.wait_for_selector("#teleop-link[data-transport='websocket']", timeout=30000)
+    assert page.watch.console_errors == []
