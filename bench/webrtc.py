@@ -14,6 +14,7 @@ change) draws the simulator's time code; until it is merged this bench's camera 
 from __future__ import annotations
 
 import argparse
+import array
 import asyncio
 import statistics
 import subprocess
@@ -75,7 +76,9 @@ def camera() -> None:
         msg = Image()
         msg.header.stamp.sec, msg.header.stamp.nanosec = int(now), int((now % 1) * 1e9)
         msg.width, msg.height, msg.encoding, msg.step = WIDTH, HEIGHT, "rgb8", WIDTH * 3
-        msg.data = pixels.tobytes()
+        data = array.array("B")
+        data.frombytes(pixels.tobytes())  # an array.array is taken as is; bytes would be checked byte by byte
+        msg.data = data
         pub.publish(msg)
         count[0] = n + 1
 

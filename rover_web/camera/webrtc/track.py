@@ -52,6 +52,7 @@ class CameraTrack(MediaStreamTrack):
         self._seq = 0
         self._started: float | None = None
         self._last_sent = 0.0
+        self._last_pts = -1
         self.frames_sent = 0
         self.output: Output | None = None
         self.last_stamp = 0.0
@@ -67,24 +68,36 @@ class CameraTrack(MediaStreamTrack):
             if self.readyState != "live":
                 raise MediaStreamError
             try:
-                got = await loop.run_in_executor(self._pool, self.producer.next_frame, self._seq, WAIT_S)
+                # One hand-off per frame: waiting, the adaptation and the conversion in one pool call
+                # (on a loaded machine every thread wake-up costs; MJPEG's request thread has none).
+                made = await loop.run_in_executor(self._pool, self._next_frame)
             except StreamClosed:
                 self.stop()
                 raise MediaStreamError from None
-            if got is not None:
+            if made is not None:
                 break
-        self._seq, picture = got
+        frame, picture = made
         if picture.error is not None and picture.error != self.last_error:
             log.warning("WebRTC stream of %s: %s", self.producer.key.topic, picture.error)
         self.last_error = picture.error
-        self.output = self.policy.update(self.target_bitrate(), picture.width, picture.height)
-        frame = await loop.run_in_executor(self._pool, to_video_frame, picture, self.output)
         now = time.monotonic()
         if self._started is None:
             self._started = now
-        frame.pts = int((now - self._started) * VIDEO_CLOCK_HZ)
+        pts = int((now - self._started) * VIDEO_CLOCK_HZ)
+        frame.pts = max(pts, self._last_pts + 1)  # strictly increasing, whatever the clock did
         frame.time_base = TIME_BASE
+        self._last_pts = frame.pts
         self._last_sent = now
         self.last_stamp = picture.stamp
         self.frames_sent += 1
         return frame
+
+    def _next_frame(self) -> tuple[av.VideoFrame, Picture] | None:
+        """In the pool: the newest picture after the last one sent (None after WAIT_S without one),
+        at the size and rate the adaptation says now."""
+        got = self.producer.next_frame(self._seq, WAIT_S)
+        if got is None:
+            return None
+        self._seq, picture = got
+        self.output = self.policy.update(self.target_bitrate(), picture.width, picture.height)
+        return to_video_frame(picture, self.output), picture
