@@ -68,17 +68,15 @@ KEEP_PCS = """
 
 
 @pytest.fixture(scope="module")
-def loopback_browser():
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as pw:
-        browser = pw.chromium.launch(executable_path=CHROMIUM, args=[
-            "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader", "--disable-background-networking",
-            "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic",
-            "--allow-loopback-in-peer-connection",  # gather 127.0.0.1 (left out by default)
-            "--autoplay-policy=no-user-gesture-required"])
-        yield browser
-        browser.close()
+def loopback_browser(browser):
+    # A second Chromium from the session's Playwright (one sync Playwright per thread), with two flags more.
+    loopback = browser.browser_type.launch(executable_path=CHROMIUM, args=[
+        "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader", "--disable-background-networking",
+        "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic",
+        "--allow-loopback-in-peer-connection",  # gather 127.0.0.1 (left out by default)
+        "--autoplay-policy=no-user-gesture-required"])
+    yield loopback
+    loopback.close()
 
 
 @pytest.fixture
