@@ -195,8 +195,17 @@ function start() {
     };
   }
 
-  // The camera's data channel opened: reconnect over it (it ends itself when the channel closes).
-  teleopChannel.onChange((open) => { if (open && ws) ws.close(); });
+  // The camera's data channel opened: move over to it at once (it ends itself when the channel closes).
+  teleopChannel.onChange((open) => {
+    if (!open || !ws) return;
+    const old = ws;
+    old.onclose = null;
+    old.close();  // the server frees control this socket held (and zeroes the robot if it moved)
+    session = null;
+    inControl = false;
+    driving = false;
+    connect();
+  });
 
   // --- inputs ---
 

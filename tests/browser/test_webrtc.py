@@ -16,7 +16,6 @@ import requests
 from rover_web.camera.service import CameraStreams
 from rover_web.camera.webrtc.service import WebRtcService
 from tests.conftest import CHROMIUM, PageWatch
-from tests.support.waiting import wait_until
 
 pytestmark = pytest.mark.browser
 
@@ -90,6 +89,16 @@ def webrtc_page(loopback_browser):
     context.close()
 
 
+def wait_page(page, predicate, timeout, what):
+    """Poll while Playwright runs: the pages' requests pass through its router (PageWatch), which
+    only moves while the test calls into Playwright, so time.sleep would hold them."""
+    deadline = time.monotonic() + timeout
+    while not (value := predicate()):
+        assert time.monotonic() < deadline, f"{what} not reached within {timeout} s"
+        page.wait_for_timeout(100)
+    return value
+
+
 def decoded(page) -> int:
     return int(page.get_attribute("#camera-card", "data-webrtc-frames-decoded") or 0)
 
@@ -107,9 +116,9 @@ def test_video_plays_over_loopback_and_shows_its_stats(live_server, sim_process,
     page = webrtc_page
     page.goto(live_server.url + "/")
     page.wait_for_selector("#camera-card[data-transport-in-use='webrtc']", timeout=30000)
-    wait_until(lambda: decoded(page) > 0, 20, "frames decoded")
+    wait_page(page, lambda: decoded(page) > 0, 20, "frames decoded")
     first = decoded(page)
-    wait_until(lambda: decoded(page) > first + 10, 20, "frames decoded keep rising")
+    wait_page(page, lambda: decoded(page) > first + 10, 20, "frames decoded keep rising")
     assert page.locator("#camera-video").is_visible() and page.locator("#camera-image").is_hidden()
     size = page.evaluate("() => { const v = document.getElementById('camera-video');"
                          " return [v.videoWidth, v.videoHeight]; }")
@@ -126,7 +135,7 @@ def test_video_plays_over_loopback_and_shows_its_stats(live_server, sim_process,
     assert page.watch.offhost == [] and page.watch.console_errors == []
     # Leaving the page ends the session on the server.
     page.goto("about:blank")
-    wait_until(lambda: not live_server.rover.feature(WebRtcService).sessions(), 20, "the session ended")
+    wait_page(page, lambda: not live_server.rover.feature(WebRtcService).sessions(), 20, "the session ended")
 
 
 def test_mjpeg_when_picked_and_remembered(live_server, sim_process, webrtc_page):
@@ -136,13 +145,13 @@ def test_mjpeg_when_picked_and_remembered(live_server, sim_process, webrtc_page)
     page.wait_for_selector("#camera-card[data-transport-in-use='webrtc']", timeout=30000)
     page.select_option("#camera-transport", "mjpeg")
     camera = live_server.rover.feature(CameraStreams)
-    wait_until(lambda: camera.viewers == 1, 30, "the MJPEG stream")
+    wait_page(page, lambda: camera.viewers == 1, 30, "the MJPEG stream")
     page.wait_for_selector("#camera-card[data-transport-in-use='mjpeg']", timeout=5000)
-    wait_until(lambda: not live_server.rover.feature(WebRtcService).sessions(), 20, "the WebRTC session ended")
+    wait_page(page, lambda: not live_server.rover.feature(WebRtcService).sessions(), 20, "the WebRTC session ended")
     page.reload()
-    wait_until(lambda: camera.viewers == 1, 20, "MJPEG again after a reload")
+    wait_page(page, lambda: camera.viewers == 1, 20, "MJPEG again after a reload")
     assert page.locator("#camera-transport").input_value() == "mjpeg"
-    time.sleep(1)
+    page.wait_for_timeout(1000)
     assert not live_server.rover.feature(WebRtcService).sessions()
     assert page.watch.console_errors == []
 
@@ -156,7 +165,7 @@ def test_falls_back_to_mjpeg_when_webrtc_is_refused(live_server_factory, sim_pro
     page = webrtc_page
     page.goto(server.url + "/")
     page.wait_for_selector("#camera-card[data-transport-in-use='mjpeg']", timeout=30000)
-    wait_until(lambda: server.rover.feature(CameraStreams).viewers == 1, 20, "MJPEG instead")
+    wait_page(page, lambda: server.rover.feature(CameraStreams).viewers == 1, 20, "MJPEG instead")
     assert "MJPEG" in page.locator("#camera-stats").inner_text()
     requests.delete(server.url + taken.headers["Location"], timeout=5)
 
@@ -170,7 +179,7 @@ def test_falls_back_to_mjpeg_when_webrtc_cannot_connect(live_server, sim_process
         body=_strip_candidates(route.fetch().text())))
     page.goto(live_server.url + "/")
     page.wait_for_selector("#camera-card[data-transport-in-use='mjpeg']", timeout=30000)
-    wait_until(lambda: live_server.rover.feature(CameraStreams).viewers == 1, 20, "MJPEG instead")
+    wait_page(page, lambda: live_server.rover.feature(CameraStreams).viewers == 1, 20, "MJPEG instead")
 
 
 def _strip_candidates(sdp: str) -> str:
@@ -209,7 +218,7 @@ def test_the_drive_card_can_use_the_teleop_channel(live_server, sim_process, web
     assert got["first"]["type"] == "hello" and got["first"]["in_control"] is True
     assert got["first"]["transport"] == "datachannel"
     assert got["closed"] and got["stillOpen"]  # closing the look-alike leaves the camera's channel open
-    wait_until(lambda: requests.get(live_server.url + "/api/teleop", timeout=5).json()["linear_mps"] == 1.0, 10,
+    wait_page(page, lambda: requests.get(live_server.url + "/api/teleop", timeout=5).json()["linear_mps"] == 1.0, 10,
                "the look-alike's drive frame reached the robot")
     holder = requests.get(live_server.url + "/api/teleop", timeout=5).json()["holder"]
     assert holder is not None
@@ -222,10 +231,10 @@ def test_a_hidden_tab_ends_its_webrtc_session(live_server, sim_process, webrtc_p
     page.wait_for_selector("#camera-card[data-transport-in-use='webrtc']", timeout=30000)
     page.evaluate("() => { Object.defineProperty(document, 'hidden', {value: true, configurable: true});"
                   " document.dispatchEvent(new Event('visibilitychange')); }")
-    wait_until(lambda: not live_server.rover.feature(WebRtcService).sessions(), 20, "the session ended")
+    wait_page(page, lambda: not live_server.rover.feature(WebRtcService).sessions(), 20, "the session ended")
     page.evaluate("() => { Object.defineProperty(document, 'hidden', {value: false, configurable: true});"
                   " document.dispatchEvent(new Event('visibilitychange')); }")
-    wait_until(lambda: live_server.rover.feature(WebRtcService).sessions(), 30, "a new session when shown")
+    wait_page(page, lambda: live_server.rover.feature(WebRtcService).sessions(), 30, "a new session when shown")
     page.wait_for_selector("#camera-card[data-transport-in-use='webrtc']", timeout=30000)
 
 
@@ -238,10 +247,10 @@ def test_the_drive_card_drives_over_the_data_channel_and_back_on_the_websocket(l
     assert "data channel" in page.locator("#teleop-link").inner_text()
     page.locator("body").click(position={"x": 5, "y": 5})
     page.keyboard.down("KeyW")
-    wait_until(lambda: requests.get(live_server.url + "/api/teleop", timeout=5).json()["linear_mps"] > 0, 10,
+    wait_page(page, lambda: requests.get(live_server.url + "/api/teleop", timeout=5).json()["linear_mps"] > 0, 10,
                "the Drive card drives over the data channel")
     page.keyboard.up("KeyW")
-    wait_until(lambda: requests.get(live_server.url + "/api/teleop", timeout=5).json()["linear_mps"] == 0, 10,
+    wait_page(page, lambda: requests.get(live_server.url + "/api/teleop", timeout=5).json()["linear_mps"] == 0, 10,
                "and stops")
     page.select_option("#camera-transport", "mjpeg")  # the peer connection goes: the WebSocket again
     page.wait_for_selector("#teleop-link[data-transport='websocket']", timeout=30000)
