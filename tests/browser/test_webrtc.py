@@ -210,7 +210,9 @@ def test_the_drive_card_can_use_the_teleop_channel(live_server, sim_process, web
       const sock = teleopChannel.socket();
       const first = await new Promise((resolve) => { sock.onmessage = (e) => resolve(JSON.parse(e.data)); });
       // Held (repeated within the deadman) until the server's state says the robot moves.
-      const timer = setInterval(() => sock.send(JSON.stringify({ linear: 0.2, angular: 0, epoch: first.epoch })), 50);
+      // With the newest epoch, as the Drive card does: a stall past the deadman bumps it.
+      const epoch = () => [first, ...seen].filter((m) => m.type === 'hello' || m.type === 'state').pop().epoch;
+      const timer = setInterval(() => sock.send(JSON.stringify({ linear: 0.2, angular: 0, epoch: epoch() })), 50);
       let drove = false;
       while (!drove && Date.now() < deadline + 10000) {
         drove = (await (await fetch('/api/teleop')).json()).linear_mps === 1.0;
@@ -227,7 +229,7 @@ def test_the_drive_card_can_use_the_teleop_channel(live_server, sim_process, web
     assert got["first"]["type"] == "hello" and got["first"]["in_control"] is True
     assert got["first"]["transport"] == "datachannel"
     assert got["closed"] and got["stillOpen"]  # closing the look-alike leaves the camera's channel open
-    assert got["drove"], "the look-alike's drive frames reached the robot"
+    assert got["drove"], ("the look-alike's drive frames reached the robot", got["first"], got["seen"][-6:])
     holder = requests.get(live_server.url + "/api/teleop", timeout=5).json()["holder"]
     assert holder is not None
 
