@@ -222,6 +222,16 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("CAMERA_TOTAL_MAX_KBPS", 0, "int",
             "most kbit/s all MJPEG viewers together get, shared fairly (0: no total cap); needs CAMERA_ADAPT",
             0, 10_000_000),
+    # --- camera over WebRTC (WHEP) ---
+    Setting("WEBRTC_MAX_VIEWERS", 4, "int",
+            "most WebRTC camera sessions at once, each with its own encoder (503 beyond: watch MJPEG)", 0, 64),
+    Setting("WEBRTC_MAX_FPS", 30.0, "float", "most frames a second a WebRTC viewer is sent", 1, 60),
+    Setting("WEBRTC_IDLE_TIMEOUT_S", 15.0, "float",
+            "a WebRTC session not connected for this long (never, or lost) is closed", 1, 3600),
+    Setting("WEBRTC_ICE_SERVERS", [], "list",
+            "ICE servers (stun:host:port, turn:user:secret@host:port); empty: none, no STUN to the internet"),
+    Setting("WEBRTC_HOST_ADDRESSES", [], "list",
+            "the only IP addresses offered as host candidates (e.g. the radio's); empty: every interface's"),
     # --- topic browser ---
     Setting("TOPICS_REFRESH_S", 1.0, "float",
             "how often the topic list (`topics` channel) is re-read from the ROS graph",

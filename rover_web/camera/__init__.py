@@ -13,7 +13,7 @@ from __future__ import annotations
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover, current_feature
 
-from . import routes
+from . import routes, webrtc
 from .service import CameraStreams
 
 
@@ -21,6 +21,7 @@ def init_app(app, fleet: Fleet) -> None:
     for rover in fleet:
         _init_robot(rover)
     app.register_blueprint(routes.bp)
+    webrtc.init_app(app, fleet, lambda rover: rover.feature(CameraStreams))
     app.jinja_env.globals["camera_panel"] = lambda: current_feature(CameraStreams).panel()
 
 

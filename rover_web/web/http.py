@@ -124,6 +124,17 @@ def _view_accepts_form() -> bool:
 # goes to this host over https only for a year, so a sign-in is never sent in clear by a typed
 # http:// address. No includeSubDomains: a robot's name says nothing about its neighbours'.
 HSTS = "max-age=31536000"
+def accepts_media(*types: str):
+    """Mark a view whose body has a media type of its own besides JSON (WHEP's application/sdp)."""
+    def mark(view):
+        view.accepts_media = types
+        return view
+    return mark
+
+
+def _view_accepts_media() -> tuple[str, ...]:
+    view = current_app.view_functions.get(request.endpoint) if request.endpoint else None
+    return getattr(view, "accepts_media", ())
 
 
 def _security_headers(response):
@@ -153,7 +164,8 @@ def _guard():
         # Refuse before routing or reading, whatever the route does with its body.
         return error_response(413, "request_entity_too_large", f"request body is larger than {limit} bytes")
     if (request.method in ("POST", "PUT", "PATCH") and request.mimetype != "application/json"
-            and not (request.mimetype in FORM_TYPES and _view_accepts_form())):
+            and not (request.mimetype in FORM_TYPES and _view_accepts_form())
+            and request.mimetype not in _view_accepts_media()):
         return error_response(415, "unsupported_media_type",
                               "send the body as JSON with the header Content-Type: application/json")
     return None

@@ -8,6 +8,7 @@
 import { api, at } from './api.js';
 import { describe, watchViewer } from './camera/stats.js';
 import { pollSnapshots } from './camera/snapshots.js';
+import { play as playWebRtc, stop as stopWebRtc } from './camera/webrtc.js';
 
 const card = document.getElementById('camera-card');
 const STORAGE_KEY = 'rover_web.camera.topic';
@@ -52,6 +53,7 @@ if (card) {
 
   function stop() {
     if (stopWatching) { stopWatching(); stopWatching = null; }
+    stopWebRtc();
     if (streaming === null) return;
     streaming = null;
     img.src = BLANK;  // ends the MJPEG request (or the snapshot loop); the server releases the stream
@@ -86,7 +88,15 @@ if (card) {
       recheckTimer = setTimeout(refreshTopics, RECHECK_MS);
       return;
     }
-    if (mode === 'snapshots') { startSnapshots(); return; }
+    if (mode === 'snapshots') { startSnapshots(); return; }  // the slowest links: no stream at all
+    if (playWebRtc(topic, start)) {  // WebRTC first; it calls start() again if it falls back
+      if (streaming !== null) { streaming = null; img.src = BLANK; }
+      if (stopWatching) { stopWatching(); stopWatching = null; }
+      img.hidden = true;
+      say('');
+      return;
+    }
+    img.hidden = false;
     const url = at(`/stream?${query(topic)}&width=640&viewer=${label}`);
     if (streaming === url) return;
     stop();
@@ -140,6 +150,7 @@ if (card) {
   modeSelect.value = mode;
   modeSelect.addEventListener('change', () => setMode(modeSelect.value));
   suggest.querySelector('button').addEventListener('click', () => setMode('snapshots'));
+  card.addEventListener('camera:transport', () => { streaming = null; start(); });
   select.addEventListener('focus', refreshTopics);
   document.addEventListener('visibilitychange', start);
 

@@ -11,6 +11,7 @@ import { on } from './live.js';
 import { operatorName, setOperatorName } from './operator.js';
 import { startGamepad } from './teleop_gamepad.js';
 import { setEstopSender } from './teleop_link.js';
+import { teleopChannel } from './camera/teleop_channel.js';
 
 const card = document.getElementById('teleop-card');
 if (card) start();
@@ -143,7 +144,8 @@ function start() {
       retryMs = 500;
       const link = $('teleop-link');
       link.dataset.state = 'live';
-      link.textContent = `connected as ${m.name}`;
+      link.dataset.transport = m.transport || 'websocket';  // the camera's data channel, when it is up
+      link.textContent = `connected as ${m.name}${m.transport === 'datachannel' ? ' (data channel)' : ''}`;
     }
     if (m.type === 'hello' || m.type === 'state') {
       epoch = m.epoch;
@@ -173,7 +175,8 @@ function start() {
 
   function connect() {
     const scheme = location.protocol === 'https:' ? 'wss:' : 'ws:';
-    ws = new WebSocket(`${scheme}//${location.host}${base}/ws/teleop?name=${encodeURIComponent(operatorName())}`);
+    ws = teleopChannel.socket()
+      || new WebSocket(`${scheme}//${location.host}${base}/ws/teleop?name=${encodeURIComponent(operatorName())}`);
     ws.onmessage = (ev) => {
       let m;
       try { m = JSON.parse(ev.data); } catch { return; }
@@ -191,6 +194,18 @@ function start() {
       retryMs = Math.min(retryMs * 2, 5000);
     };
   }
+
+  // The camera's data channel opened: move over to it at once (it ends itself when the channel closes).
+  teleopChannel.onChange((open) => {
+    if (!open || !ws) return;
+    const old = ws;
+    old.onclose = null;
+    old.close();  // the server frees control this socket held (and zeroes the robot if it moved)
+    session = null;
+    inControl = false;
+    driving = false;
+    connect();
+  });
 
   // --- inputs ---
 

@@ -7,6 +7,14 @@ import pytest
 from rover_web.camera.service import CameraStreams
 
 pytestmark = pytest.mark.browser
+# These are MJPEG's tests; the card plays WebRTC when it can (tests/browser/test_webrtc.py).
+MJPEG = "localStorage.setItem('rover_web.camera.transport', 'mjpeg')"
+
+
+@pytest.fixture(autouse=True)
+def _mjpeg(request):
+    if "page" in request.fixturenames:
+        request.getfixturevalue("page").context.add_init_script(MJPEG)
 
 
 def image_loaded(page):

@@ -193,6 +193,7 @@ def test_estop_reaches_the_server_within_a_second_with_eight_tabs_open(live_serv
 
 def test_a_hidden_tab_closes_its_camera_stream_and_opens_it_again_when_shown(live_server, sim_process, context):
     sim_process()
+    context.add_init_script("localStorage.setItem('rover_web.camera.transport', 'mjpeg')")  # MJPEG's test
     viewers = lambda: requests.get(live_server.url + "/api/camera/streams", timeout=5).json()["viewers"]  # noqa: E731
     pages = open_tabs(context, live_server.url + "/", 2)
     wait_until(lambda: viewers() == 2, 20, "both tabs streaming the camera")

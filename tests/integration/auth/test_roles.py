@@ -43,6 +43,8 @@ REQUESTS = [
      "admin", "/api/actions/goal"),
     ("POST", "/api/actions/" + "0" * 32 + "/cancel", {}, "operator", "/api/actions/<goal_id>/cancel"),
     ("POST", "/api/me/sessions/revoke", {}, "viewer", "/api/me/sessions/revoke"),  # tokens stay valid
+    ("POST", "/api/camera/whep?topic=/camera/image_raw", {}, "viewer", "/api/camera/whep"),
+    ("DELETE", "/api/camera/whep/nosuchsession", None, "viewer", "/api/camera/whep/<session_id>"),
     ("POST", "/logout", {}, "viewer", "/logout"),
 ]
 # Routes whose success needs a ROS peer: for a caller who may use them, this answer (from the view,
@@ -52,6 +54,9 @@ ANSWERED_WITHOUT_A_PEER = {
     "/api/services/call": (404, "unknown_service"),
     "/api/actions/goal": (400, "unknown_field"),
     "/api/actions/<goal_id>/cancel": (404, "unknown_goal"),
+    # WHEP takes an SDP body (tests/integration/camera/webrtc): JSON gets this, past the role check.
+    "/api/camera/whep": (415, "unsupported_media_type"),
+    "/api/camera/whep/<session_id>": (404, "unknown_session"),
 }
 RANK = {None: -1, "viewer": 0, "operator": 1, "admin": 2}
 PUBLIC = {("POST", "/login"), ("POST", "/login/estop")}  # tests/integration/estop/test_estop_all.py

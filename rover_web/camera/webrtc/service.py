@@ -1,0 +1,453 @@
+"""WebRtcService: one robot's WHEP sessions, each a peer connection that sends the camera and may
+carry the teleop data channel.
+
+Lifecycle of a session (all peer-connection work on the LoopThread):
+- `open` (a request thread): the query is checked as /stream's (CameraStreams.key_for), a viewer
+  place (ROVER_WEB_WEBRTC_MAX_VIEWERS) and a slot of ROVER_WEB_MAX_STREAMS are taken, the shared
+  frame producer is leased, then the offer is answered on the loop (candidates gathered before
+  answering: no trickle). Any failure gives all of it back before the error is answered.
+- it ends on DELETE, when its peer connection fails or closes, when it has not been connected for
+  ROVER_WEB_WEBRTC_IDLE_TIMEOUT_S (never connected, or lost), when its user is revoked
+  (`close_sessions_of`), and at shutdown; `_end` gives everything back exactly once.
+
+The user and whether they may drive are read when the session is made and kept on it: the teleop
+channel is refused to a session whose user was not an operator then, and the lead's revocation
+hook ends the sessions of a user whose rights change.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import logging
+import secrets
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from typing import Any
+
+from aiortc import RTCConfiguration, RTCIceServer, RTCPeerConnection, RTCSessionDescription
+from aiortc.rtcdtlstransport import X509_DIGEST_ALGORITHMS
+from aiortc.rtp import RTCP_PSFB_APP, RtcpPsfbPacket, unpack_remb_fci
+from aiortc.sdp import SessionDescription
+
+from rover_web import process
+from rover_web.auth.policy import is_loopback
+from rover_web.camera import msgs as camera_msgs
+from rover_web.camera.service import CameraStreams, CannotSubscribe, Unavailable
+from rover_web.camera.stream import FrameProducer, StreamKey
+from rover_web.config import ConfigError
+from rover_web.core.leases import Closed, Full, Leases
+from rover_web.core.state import Rover
+from rover_web.core.streams import StreamSlot, TooManyStreams
+from rover_web.web.validate import InvalidInput
+
+from . import frames
+from .adapt import AdaptPolicy
+from .ice import candidate_address, check_addresses, filter_candidates, only_host_addresses, parse_ice_server
+from .loop import LoopStopped, LoopThread
+from .track import CameraTrack
+
+log = logging.getLogger(__name__)
+
+# How long a request thread waits for the loop to answer an offer (gathering included).
+NEGOTIATE_TIMEOUT_S = 10.0
+CLOSE_TIMEOUT_S = 5.0
+WATCH_PERIOD_S = 0.5
+MAX_OFFER_CHARS = 64 * 1024
+
+
+class NoVideo(InvalidInput):
+    pass
+
+
+@dataclass(eq=False)
+class WhepSession:
+    id: str
+    user: str | None
+    role: str | None
+    may_operate: bool
+    key: StreamKey
+    slot: StreamSlot
+    created: float = field(default_factory=time.monotonic)
+    producer: FrameProducer | None = None
+    pc: Any = None
+    track: CameraTrack | None = None
+    sender: Any = None
+    teleop: Any = None  # rover_web.teleop.datachannel.TeleopChannel once the channel opened
+    state: str = "new"
+    last_connected: float | None = None
+    ended: str | None = None  # why it ended
+    remb_bps: int | None = None  # the browser's latest estimate, unclamped
+    revocation: Any = None  # its credential's registration (auth/revocation.py), cancelled when it ends
+
+    def encoder_bitrate(self) -> int | None:
+        # aiortc sets its encoder's target from each REMB packet, clamped (250 kbit/s to 1.5 Mbit/s
+        # for VP8); the encoder is the sender's own, private attribute (aiortc is pinned).
+        encoder = getattr(self.sender, "_RTCRtpSender__encoder", None)
+        return getattr(encoder, "target_bitrate", None)
+
+    def target_bitrate(self) -> int | None:
+        """What the link allows, for the adaptation: the browser's estimate when one came (aiortc's
+        encoder cannot go below its floor, so the estimate says more), else the encoder's target."""
+        return self.remb_bps if self.remb_bps is not None else self.encoder_bitrate()
+
+    def describe(self) -> dict:
+        track = self.track
+        out = track.output if track else None
+        return {"user": self.user, "topic": self.key.topic, "state": self.state,
+                "frames_sent": track.frames_sent if track else 0,
+                "level": out.level if out else None, "width": out.width if out else None,
+                "height": out.height if out else None, "fps": out.fps if out else None,
+                "target_bps": self.encoder_bitrate(), "remb_bps": self.remb_bps,
+                "teleop": self.teleop is not None and not self.teleop.closed,
+                "source_hz": self.producer.arrivals.snapshot(stale_after_s=2.0)["rate_hz"] if self.producer else None,
+                "age_s": round(time.monotonic() - self.created, 1)}
+
+
+def host_addresses(config) -> tuple[str, ...]:
+    """The setting's addresses; when it is empty and the server listens on loopback only, 127.0.0.1
+    (nobody elsewhere can reach the page, so no other address is worth offering: the tests rely on
+    this); else () for every interface's."""
+    try:
+        chosen = check_addresses(config["ROVER_WEB_WEBRTC_HOST_ADDRESSES"])
+    except ValueError as exc:
+        raise ConfigError(f"ROVER_WEB_WEBRTC_HOST_ADDRESSES: {exc}") from None
+    if chosen:
+        return chosen
+    listening = process.listen_hosts(config)
+    if listening and all(is_loopback(h) for h in listening):
+        return ("127.0.0.1",)
+    return ()
+
+
+def _without_mdns(offer: str) -> str:
+    """Drop the offer's mDNS (`.local`) candidates: resolving them would send multicast queries on
+    every interface. A browser behind one is found anyway, from its connectivity checks (a
+    peer-reflexive candidate)."""
+    lines = offer.split("\n")
+    kept = [line for line in lines if not ((found := candidate_address(line)) and found[0].endswith(".local"))]
+    return "\n".join(kept)
+
+
+def _check_fingerprints(offer: str) -> None:
+    """aiortc takes an offer whose DTLS fingerprints it cannot check, then fails the handshake
+    later; say so now, as a 400."""
+    for media in SessionDescription.parse(offer).media:
+        if not any(f.algorithm in X509_DIGEST_ALGORITHMS for f in media.dtls.fingerprints):
+            raise InvalidInput(f"the offer's {media.kind} section has no DTLS fingerprint this server can check "
+                               f"({', '.join(X509_DIGEST_ALGORITHMS)})", "bad_sdp")
+
+
+def tap_remb(session: WhepSession) -> None:
+    """Keep each REMB estimate the browser sends for this sender, before aiortc clamps it."""
+    sender = session.sender
+    handle = sender._handle_rtcp_packet  # called per RTCP packet by the DTLS transport's router
+
+    async def _handle(packet) -> None:
+        if isinstance(packet, RtcpPsfbPacket) and packet.fmt == RTCP_PSFB_APP:
+            try:
+                bitrate, ssrcs = unpack_remb_fci(packet.fci)
+            except ValueError:
+                bitrate, ssrcs = None, ()
+            if bitrate is not None and sender._ssrc in ssrcs:
+                session.remb_bps = bitrate
+        await handle(packet)
+
+    sender._handle_rtcp_packet = _handle
+
+
+class WebRtcService:
+    def __init__(self, rover: Rover, loop: LoopThread, camera: CameraStreams):
+        config = rover.config
+        self.rover = rover
+        self.loop = loop
+        self.camera = camera
+        self.max_viewers = config["ROVER_WEB_WEBRTC_MAX_VIEWERS"]
+        self.idle_timeout_s = config["ROVER_WEB_WEBRTC_IDLE_TIMEOUT_S"]
+        self.max_fps = config["ROVER_WEB_WEBRTC_MAX_FPS"]
+        self.host_addresses = host_addresses(config)
+        try:
+            self.ice_servers = [parse_ice_server(s) for s in config["ROVER_WEB_WEBRTC_ICE_SERVERS"]]
+        except ValueError as exc:
+            raise ConfigError(f"ROVER_WEB_WEBRTC_ICE_SERVERS: {exc}") from None
+        self.producers: Leases[FrameProducer] = Leases(self._open_producer, self._close_producer,
+                                                       config["ROVER_WEB_CAMERA_IDLE_TIMEOUT_S"],
+                                                       max_keys=config["ROVER_WEB_CAMERA_MAX_PRODUCERS"])
+        # Each viewer's track waits for frames in this pool (and builds its video frames here).
+        self._frames = ThreadPoolExecutor(max_workers=2 * self.max_viewers + 1, thread_name_prefix="webrtc-frames")
+        self._teleop = ThreadPoolExecutor(max_workers=1, thread_name_prefix="webrtc-teleop")
+        self._sessions: dict[str, WhepSession] = {}
+        self._lock = threading.Lock()
+        self._closed = False
+        self._watch: Any = None
+
+    # --- producers: the camera's subscription and newest-message store, converting for video ---
+
+    def _open_producer(self, key: StreamKey) -> FrameProducer:
+        max_pixels = self.camera.max_output_pixels
+
+        def convert(raw) -> frames.Picture:
+            try:
+                return frames.to_picture(raw, key.width, key.height, max_pixels)
+            except frames.FrameError as exc:
+                return frames.error_picture(str(exc), exc.code, key.width, key.height, max_pixels)
+            except Exception:  # a bug, not bad data: keep the stream alive and say where to look
+                log.exception("converting a frame from %s failed", key.topic)
+                return frames.error_picture("the server could not convert this frame; see its log",
+                                            "internal_error", key.width, key.height, max_pixels)
+
+        producer = FrameProducer(key, convert)  # type: ignore[arg-type]  # Picture duck-types Jpeg
+        read = camera_msgs.frame_reader(key.msg_type)
+        producer.subscription = self.rover.runtime.subscribe(
+            key.msg_type, key.topic, lambda msg: producer.put(read(msg)), qos=key.qos, track=False)
+        return producer
+
+    def _close_producer(self, producer: FrameProducer) -> None:
+        producer.close()
+        if self.rover.runtime.running:
+            self.rover.runtime.destroy(producer.subscription)
+
+    # --- life ---
+
+    def start(self) -> None:
+        self._watch = self.loop.submit(self._watch_sessions())
+
+    async def _watch_sessions(self) -> None:
+        running = asyncio.get_running_loop()
+        while True:
+            await asyncio.sleep(WATCH_PERIOD_S)
+            now = time.monotonic()
+            for session in self.sessions():
+                since = session.last_connected if session.state != "connected" and session.last_connected \
+                    else session.created
+                if session.state != "connected" and now - since > self.idle_timeout_s:
+                    await self._end(session, "idle")
+            await running.run_in_executor(self._frames, self.producers.reap)
+
+    def close(self) -> None:
+        """Shutdown: every session ended, producers and pools closed. Idempotent."""
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+        if self.loop.running:
+            try:
+                self.loop.run(self._end_all("shutdown"), CLOSE_TIMEOUT_S)
+            except (TimeoutError, LoopStopped):
+                log.warning("WebRTC sessions did not all close within %.1f s", CLOSE_TIMEOUT_S)
+        if self._watch is not None:
+            self._watch.cancel()
+        self.producers.close_all()
+        for session in self.sessions():  # the loop was gone: give back what it could not
+            self._give_back(session)
+        self._frames.shutdown(wait=True, cancel_futures=True)
+        self._teleop.shutdown(wait=True, cancel_futures=True)
+
+    async def _end_all(self, reason: str) -> None:
+        await asyncio.gather(*(self._end(s, reason) for s in self.sessions()), return_exceptions=True)
+
+    # --- requests ---
+
+    def sessions(self) -> list[WhepSession]:
+        with self._lock:
+            return list(self._sessions.values())
+
+    def describe(self) -> dict:
+        return {"max_viewers": self.max_viewers, "sessions": [s.describe() for s in self.sessions()]}
+
+    def open(self, args, offer: str, *, user: str | None, role: str | None, may_operate: bool) -> tuple[str, str]:
+        """Answer a WHEP offer: (session id, SDP answer). InvalidInput, UnknownTopic, Unavailable,
+        CannotSubscribe as CameraStreams raises them."""
+        key = self.camera.key_for(args)
+        if len(offer) > MAX_OFFER_CHARS:
+            raise InvalidInput(f"the offer is longer than {MAX_OFFER_CHARS} characters", "bad_sdp")
+        if not offer.lstrip().startswith("v=0"):
+            raise InvalidInput("the body is not an SDP offer (it must start with v=0)", "bad_sdp")
+        if "\nm=video " not in offer.replace("\r\n", "\n"):
+            raise NoVideo("the offer has no video media section: add a recvonly video transceiver", "no_video")
+        session = self._reserve(key, user, role, may_operate)
+        try:
+            try:
+                session.producer = self.producers.acquire(key)
+            except Closed:
+                raise Unavailable("the server is shutting down", "shutting_down") from None
+            except Full:
+                raise Unavailable(f"{len(self.producers)} different WebRTC camera streams are converted already "
+                                  "(ROVER_WEB_CAMERA_MAX_PRODUCERS); view one of them", "too_many_producers") from None
+            except Exception as exc:
+                log.exception("cannot subscribe to %s", key.topic)
+                raise CannotSubscribe(f"cannot subscribe to {key.topic}: {exc}", "cannot_subscribe") from None
+            try:
+                answer = self.loop.run(self._negotiate(session, offer), NEGOTIATE_TIMEOUT_S)
+            except LoopStopped:
+                raise Unavailable("the server is shutting down", "shutting_down") from None
+            except TimeoutError:
+                raise Unavailable("the WebRTC loop did not answer the offer in time", "webrtc_timeout") from None
+        except BaseException:
+            self._abandon(session)
+            raise
+        return session.id, answer
+
+    def _reserve(self, key: StreamKey, user: str | None, role: str | None, may_operate: bool) -> WhepSession:
+        with self._lock:
+            if self._closed:
+                raise Unavailable("the server is shutting down", "shutting_down")
+            if len(self._sessions) >= self.max_viewers:
+                raise Unavailable(f"{len(self._sessions)} WebRTC viewers are connected already "
+                                  f"(ROVER_WEB_WEBRTC_MAX_VIEWERS); watch the MJPEG stream instead: "
+                                  f"GET /stream?topic={key.topic}", "too_many_webrtc_viewers")
+            try:
+                slot = self.rover.streams.acquire("webrtc")
+            except TooManyStreams as exc:
+                raise Unavailable(str(exc), "too_many_streams") from None
+            session = WhepSession(secrets.token_urlsafe(16), user, role, may_operate, key, slot)
+            self._sessions[session.id] = session
+            return session
+
+    def _abandon(self, session: WhepSession) -> None:
+        """An offer that failed: its peer connection (if any) closed on the loop, the rest given back."""
+        if session.pc is not None and self.loop.running:
+            try:
+                self.loop.run(self._end(session, "refused"), CLOSE_TIMEOUT_S)
+                return
+            except (TimeoutError, LoopStopped):
+                log.warning("closing a refused WebRTC offer's peer connection timed out")
+        self._give_back(session)
+
+    async def _negotiate(self, session: WhepSession, offer: str) -> str:
+        config = RTCConfiguration(iceServers=[RTCIceServer(**s) for s in self.ice_servers])  # [] : no STUN
+        with only_host_addresses(self.host_addresses):
+            pc = RTCPeerConnection(config)
+            session.pc = pc
+
+            @pc.on("connectionstatechange")
+            async def _state_changed() -> None:
+                session.state = pc.connectionState
+                if pc.connectionState == "connected":
+                    session.last_connected = time.monotonic()
+                elif pc.connectionState in ("failed", "closed"):
+                    await self._end(session, pc.connectionState)
+                elif session.last_connected is not None:
+                    session.last_connected = time.monotonic()  # lost now: the idle clock starts
+
+            @pc.on("datachannel")
+            def _channel(channel) -> None:
+                self._on_datachannel(session, channel)
+
+            try:
+                await pc.setRemoteDescription(RTCSessionDescription(sdp=_without_mdns(offer), type="offer"))
+            except Exception as exc:  # aiortc raises ValueError, KeyError, IndexError... for bad SDP
+                raise InvalidInput(f"the SDP offer could not be used: {str(exc)[:200] or type(exc).__name__}",
+                                   "bad_sdp") from None
+            _check_fingerprints(offer)
+            video = [t for t in pc.getTransceivers() if t.kind == "video"]
+            if not video or video[0].direction not in ("recvonly", "sendrecv"):
+                raise NoVideo("the offer's video section must be recvonly (or sendrecv)", "no_video")
+            track = CameraTrack(session.producer, self._frames, AdaptPolicy(self.max_fps), session.target_bitrate)
+            session.track = track
+            video[0].direction = "sendonly"
+            session.sender = pc.addTrack(track)
+            tap_remb(session)
+            try:
+                answer = await pc.createAnswer()
+                await pc.setLocalDescription(answer)
+            except Exception as exc:
+                raise InvalidInput(f"no answer can be made to this offer: {str(exc)[:200]}", "bad_sdp") from None
+        return filter_candidates(pc.localDescription.sdp, self.host_addresses)
+
+    def _on_datachannel(self, session: WhepSession, channel) -> None:
+        from rover_web.teleop.datachannel import LABEL, TeleopChannel
+        from rover_web.teleop.service import TeleopService
+
+        if channel.label != LABEL or session.ended:
+            channel.close()
+            return
+        if not session.may_operate or session.teleop is not None:
+            why = (f"driving needs the operator role; {session.user} is a {session.role}" if not session.may_operate
+                   else "this session has a teleop channel already")
+            channel.send(json.dumps({"type": "error", "error": "forbidden", "status": 403, "message": why}))
+            channel.close()
+            return
+        teleop = self.rover.feature(TeleopService)
+        glue = TeleopChannel(channel, teleop.controller, session.user, teleop.hello(), teleop.max_frame_bytes,
+                             call_soon=self.loop.call_soon, pool=self._teleop)
+        session.teleop = glue
+        channel.on("message", glue.on_message)
+        channel.on("close", glue.close)
+
+    def end(self, session_id: str, user: str | None = None, *, admin: bool = False) -> bool:
+        """DELETE: False when no such session (or it is someone else's and the caller is no admin)."""
+        with self._lock:
+            session = self._sessions.get(session_id)
+        if session is None or (user is not None and session.user not in (None, user) and not admin):
+            return False
+        self._run_end(session, "deleted")
+        return True
+
+    def close_sessions_of(self, user_name: str) -> int:
+        """End every session made by `user_name` (revoked, removed, or role changed); how many."""
+        found = [s for s in self.sessions() if s.user == user_name]
+        for session in found:
+            self._run_end(session, "revoked")
+        return len(found)
+
+    def watch(self, session_id: str, registration) -> None:
+        """Keep the session's revocation registration; cancelled at once if the session already ended."""
+        with self._lock:
+            session = self._sessions.get(session_id)
+            if session is not None:
+                session.revocation = registration
+        if session is None:
+            registration.cancel()
+
+    def revoke(self, session_id: str, reason: str) -> None:
+        """Its credential ended (token revoked, user removed, role or password changed, signed out):
+        end the session on the loop without waiting, as a revocation callback must not block. The
+        teleop channel, if it drives, stops the robot first (`_end`)."""
+        with self._lock:
+            session = self._sessions.get(session_id)
+        if session is None:
+            return
+        log.info("WebRTC session of %s ends: %s", session.user, reason)
+        try:
+            self.loop.submit(self._end(session, "revoked"))
+        except LoopStopped:
+            self._give_back(session)
+
+    def _run_end(self, session: WhepSession, reason: str) -> None:
+        try:
+            self.loop.run(self._end(session, reason), CLOSE_TIMEOUT_S)
+        except (TimeoutError, LoopStopped):
+            log.warning("ending WebRTC session for %s timed out", session.user)
+            self._give_back(session)
+
+    async def _end(self, session: WhepSession, reason: str) -> None:
+        if session.ended:
+            return
+        session.ended = reason
+        if session.teleop is not None:
+            session.teleop.close()  # zero first, if it held control
+        if session.track is not None:
+            session.track.stop()
+        pc = session.pc
+        if pc is not None:
+            try:
+                await pc.close()
+            except Exception:
+                log.exception("closing a WebRTC peer connection failed")
+        session.state = "closed"
+        self._give_back(session)
+
+    def _give_back(self, session: WhepSession) -> None:
+        with self._lock:
+            if self._sessions.pop(session.id, None) is None:
+                return
+        session.ended = session.ended or "closed"
+        if session.revocation is not None:
+            session.revocation.cancel()
+        if session.producer is not None:
+            self.producers.release(session.key)
+        session.slot.release()
+
