@@ -5,9 +5,10 @@ What is measured, and from what:
 - **Round trip** (`rtt_ms`): WebSocket pings carrying a 4-byte id (`ping()`), answered by the
   client's pong (`pong()`). Browsers answer pings in their network stack, without the page's
   JavaScript, so the figure is the path's own and cannot be made to look better by a page; the
-  server measures it, so it needs no trust in the client and no extra client code. Smoothed as TCP
-  does (RFC 6298, gain 1/8). A ping still unanswered counts as at least its age, so a link that
-  has gone quiet shows a growing round trip, not the last good one.
+  server measures it, so it needs no trust in the client and no extra client code. The median of
+  the last RTT_SAMPLES: one spike (a page loading its scripts) does not read as a poor link, a
+  real change shows within three samples. A ping still unanswered counts as at least its age, so
+  a link that has gone quiet shows a growing round trip, not the last good one.
 - **Jitter** (`jitter_ms`): RFC 3550's inter-arrival jitter of drive frames against the client's
   send time `t` (its own millisecond clock: only differences are used, so the two clocks need not
   agree): J += (|D| - J) / 16, with D the change in transit time between consecutive frames.
@@ -40,7 +41,7 @@ STALL_S = 0.2          # the issue's TCP stalls are 0.2-1 s; shorter gaps are ji
 WINDOW_S = 60.0        # stalls are counted, and the longest reported, over this long
 VERDICT_S = 10.0       # the verdict looks at stalls and losses this recent
 BASE_WINDOW_S = 20.0   # the best transit over this long is the reference for lateness
-RTT_GAIN = 1 / 8       # RFC 6298
+RTT_SAMPLES = 5        # two and a half seconds of pings at the socket's LINK_S
 JITTER_GAIN = 1 / 16   # RFC 3550
 PINGS_KEPT = 16        # unanswered pings remembered; older ones are taken as lost
 MIN_FRAMES_FOR_LOSS = 20
@@ -86,7 +87,7 @@ class LinkMeter:
         # round trip
         self._next_ping = 1
         self._pings: dict[int, float] = {}
-        self._srtt_s: float | None = None
+        self._rtts: deque[float] = deque(maxlen=RTT_SAMPLES)
 
     # --- frames ---
 
@@ -161,8 +162,7 @@ class LinkMeter:
             # Pongs come in order: pings sent before this one that are still open were lost.
             for older in [n for n, t in self._pings.items() if t <= sent]:
                 del self._pings[older]
-            s = self._srtt_s
-            self._srtt_s = rtt if s is None else s + (rtt - s) * RTT_GAIN
+            self._rtts.append(rtt)
             return True
 
     # --- what is shown ---
@@ -171,7 +171,7 @@ class LinkMeter:
         now = self._clock()
         with self._lock:
             self._forget(now)
-            rtt = self._srtt_s
+            rtt = sorted(self._rtts)[(len(self._rtts) - 1) // 2] if self._rtts else None  # the lower median
             if rtt is not None and self._pings:
                 rtt = max(rtt, now - min(self._pings.values()))  # waiting on an answer counts
             stalls = [s for _, s in self._stalls]

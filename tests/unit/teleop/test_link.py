@@ -34,18 +34,27 @@ def stream(meter, clock, n, period=0.05, send_ms=0.0, seq=1, transit=lambda i: 0
     return seq + n
 
 
-def test_round_trip_from_pings_smoothed_and_a_silent_link_shows_a_growing_one(rig):
+def round_trip(meter, clock, seconds):
+    payload = meter.ping()
+    clock.advance(seconds)
+    assert meter.pong(payload)
+    return payload
+
+
+def test_round_trip_from_pings_a_median_and_a_silent_link_shows_a_growing_one(rig):
     meter, clock = rig
     assert meter.snapshot()["rtt_ms"] is None
-    payload = meter.ping()
-    clock.advance(0.080)
-    assert meter.pong(payload)
+    round_trip(meter, clock, 0.080)
     assert meter.snapshot()["rtt_ms"] == 80.0
-    payload = meter.ping()
-    clock.advance(0.160)
-    meter.pong(payload)
-    assert meter.snapshot()["rtt_ms"] == pytest.approx(80 + (160 - 80) / 8, abs=0.1)  # RFC 6298's 1/8
+    payload = round_trip(meter, clock, 0.700)  # one spike: the lower median of two is the good one
+    assert meter.snapshot()["rtt_ms"] == 80.0
     assert not meter.pong(payload)  # answered already
+    for _ in range(3):  # a real change shows within three samples
+        round_trip(meter, clock, 0.850)
+    assert meter.snapshot()["rtt_ms"] == 850.0
+    for _ in range(3):
+        round_trip(meter, clock, 0.040)
+    assert meter.snapshot()["rtt_ms"] == 40.0
     assert not meter.pong(struct.pack("!I", 9999)) and not meter.pong(b"") and not meter.pong(b"12345")
     meter.ping()
     clock.advance(0.9)  # no answer: the link went quiet
