@@ -75,6 +75,7 @@ class TeleopController:
         self._on_state = on_state
         self.request_estop = request_estop  # a socket's {"estop": true}: engages the app's e-stop
         self._sessions = Sessions(clock)
+        self._holder: Session | None = None  # holds control (sessions.py); a plain attribute: read on every frame
         self._command: Command | None = None
         self._next_tick = math.inf
         self._ramping = False  # the last value published was the held command ramped down
@@ -85,14 +86,6 @@ class TeleopController:
         self._closed = False
         self._shown: dict | None = None
         self.stats: Counter = Counter()
-
-    @property
-    def _holder(self) -> Session | None:
-        return self._sessions.holder
-
-    @_holder.setter
-    def _holder(self, session: Session | None) -> None:
-        self._sessions.holder = session
 
     # --- sessions and control ---
 
@@ -106,10 +99,10 @@ class TeleopController:
         """The socket closed or failed: if it held control, zero at once and free control."""
         with self._cond:
             self._expire(self._clock())
-            held = self._holder is session
             if not self._sessions.close(session):
                 return
-            if held:
+            if self._holder is session:
+                self._holder = None
                 self._stop("disconnected")
             self._changed()
 
@@ -151,55 +144,75 @@ class TeleopController:
 
         `seq` and `sent_ms` (the client's send time, on its own millisecond clock) are optional:
         without them a frame is in order and as fresh as its arrival."""
-        with self._cond:
-            now = self._clock()
-            self._expire(now)  # a stalled server stops first, then judges the frames that piled up
-            self._require_open(session)
-            late_s = session.link.arrived(seq, sent_ms)
-            if late_s is None:
-                self.stats["out_of_order_dropped"] += 1
-                raise Refused("stale_seq", f"frame {seq} dropped: a newer frame from this socket came first")
-            if self._estop["engaged"]:
-                raise Refused("estop_engaged", "the e-stop is engaged: release it (POST /api/estop "
-                              '{"engaged": false}) before driving')
-            if not session.armed:
-                if linear or angular:
-                    raise Refused("rearm_required", f"the robot was stopped ({self._last_stop_reason()}) while "
-                                  "this input was held: release the stick (or key) to re-arm, then drive")
-                session.armed = True
-            if epoch != session.epoch:
-                self.stats["stale_dropped"] += 1
-                raise Refused("stale_epoch", f"frame for epoch {epoch} dropped: the robot was stopped "
-                              f"({self._last_stop_reason()}); send epoch {session.epoch} to drive again",
-                              epoch=session.epoch)
-            fresh_at = now - late_s
-            if self.ramp.expired(now - fresh_at):
-                self.stats["late_dropped"] += 1
-                raise Refused("late_frame", f"frame dropped: it arrived {1000 * late_s:.0f} ms late, past the "
-                              f"{1000 * self.deadman_max_s:.0f} ms any input may drive for")
-            if self._holder is None:
-                self._holder = session
-                self._tell(session, "in_control")
-            elif self._holder is not session:
-                raise Refused("not_in_control", f"{self._holder.name} holds control; you are view-only "
-                              'until they release it or you send {"takeover": true}',
-                              holder=self._holder.public())
-            new_source = source != session.source  # logged once per change, not per frame
-            session.source = source
-            linear_mps, angular_rps = scale(linear, angular, self.limits)
-            previous = self._command
-            self._command = Command(linear_mps, angular_rps, source, session, fresh_at,
-                                    fresh_at + self.deadman_max_s)
-            if (previous is None or previous.session is not session or self._ramping or late_s > self.deadman_s
-                    or (previous.linear_mps, previous.angular_rps) != (linear_mps, angular_rps)):
-                self._publish_command(now)
-                self._next_tick = now + self.period_s * INPUT_REPEAT_DELAY
-            self.stats["inputs"] += 1
-            self._changed()
-            self._cond.notify_all()
-        if new_source:  # after the publish and outside the lock: the log's I/O never delays a command
+        now = None
+        try:
+            with self._cond:
+                now = self._clock()
+                self._expire(now)  # a stalled server stops first, then judges the frames that piled up
+                self._require_open(session)
+                late_s = session.link.admit(seq, sent_ms, now)  # the meter has this controller's clock
+                if late_s is None:
+                    now = None  # dropped, and not measured either
+                    self.stats["out_of_order_dropped"] += 1
+                    raise Refused("stale_seq", f"frame {seq} dropped: a newer frame from this socket came first")
+                command = self._drive(session, linear, angular, epoch, late_s, now)
+                new_source = source != session.source  # logged once per change, not per frame
+                session.source = source
+                command.source = source
+                self._changed()
+                self._cond.notify_all()
+        finally:
+            # After the publish and outside the lock: measuring never delays a command, and
+            # frames refused for their content or their epoch still tell of the link.
+            if now is not None:
+                session.link.record(sent_ms, now)
+        if new_source:  # the log's I/O never delays a command either
             log.info("teleop: %s drives with the %s", session.name, source)
-        return linear_mps, angular_rps
+        return command.linear_mps, command.angular_rps
+
+    def _drive(self, session: Session, linear: float, angular: float, epoch: int, late_s: float,
+               now: float) -> Command:
+        """The rules for an admitted drive frame, with the lock held: the command it sets (published
+        at once if it changed), or Refused."""
+        if self._estop["engaged"]:
+            raise Refused("estop_engaged", "the e-stop is engaged: release it (POST /api/estop "
+                          '{"engaged": false}) before driving')
+        if not session.armed:
+            if linear or angular:
+                raise Refused("rearm_required", f"the robot was stopped ({self._last_stop_reason()}) while "
+                              "this input was held: release the stick (or key) to re-arm, then drive")
+            session.armed = True
+        if epoch != session.epoch:
+            self.stats["stale_dropped"] += 1
+            raise Refused("stale_epoch", f"frame for epoch {epoch} dropped: the robot was stopped "
+                          f"({self._last_stop_reason()}); send epoch {session.epoch} to drive again",
+                          epoch=session.epoch)
+        if late_s >= self.deadman_max_s:  # its input is past the bound already (ramp.expired)
+            self.stats["late_dropped"] += 1
+            raise Refused("late_frame", f"frame dropped: it arrived {1000 * late_s:.0f} ms late, past the "
+                          f"{1000 * self.deadman_max_s:.0f} ms any input may drive for")
+        if self._holder is None:
+            self._holder = session
+            self._tell(session, "in_control")
+        elif self._holder is not session:
+            raise Refused("not_in_control", f"{self._holder.name} holds control; you are view-only "
+                          'until they release it or you send {"takeover": true}',
+                          holder=self._holder.public())
+        linear_mps, angular_rps = scale(linear, angular, self.limits)
+        previous = self._command
+        fresh_at = now - late_s
+        self._command = command = Command(linear_mps, angular_rps, "", session, fresh_at,
+                                          fresh_at + self.deadman_max_s)
+        if late_s > self.deadman_s:  # came in so late that its own value is already easing off
+            self._publish_command(now)
+            self._next_tick = now + self.period_s * INPUT_REPEAT_DELAY
+        elif (previous is None or previous.session is not session or self._ramping
+                or (previous.linear_mps, previous.angular_rps) != (linear_mps, angular_rps)):
+            self._ramping = False
+            self._publish(linear_mps, angular_rps)
+            self._next_tick = now + self.period_s * INPUT_REPEAT_DELAY
+        self.stats["inputs"] += 1
+        return command
 
     def stop(self, session: Session, reason: str = "operator") -> bool:
         """The holder's own stop (stick released, key up, tab hidden). A viewer's stop is ignored."""

@@ -75,6 +75,7 @@ class LinkMeter:
         self._lock = threading.Lock()
         # seq
         self._seq: int | None = None
+        self._lost_before = 0  # frames skipped just before the one admit() let in last
         self.lost = 0
         self.out_of_order = 0
         self.frames = 0
@@ -82,8 +83,9 @@ class LinkMeter:
         self._base: deque[tuple[float, float]] = deque()  # (arrival, transit), transit increasing
         self._prev: tuple[float, float | None, float | None] | None = None  # arrival, sent_s, transit
         self._jitter_s: float | None = None
-        self._stalls: deque[tuple[float, float]] = deque()  # (when it ended, how long)
-        self._recent: deque[tuple[float, int]] = deque()    # (arrival, frames lost just before it)
+        # Pruned by snapshot(); bounded so a socket nobody asks about cannot grow them.
+        self._stalls: deque[tuple[float, float]] = deque(maxlen=1024)  # (when it ended, how long)
+        self._recent: deque[tuple[float, int]] = deque(maxlen=4096)    # (arrival, frames lost before it)
         # round trip
         self._next_ping = 1
         self._pings: dict[int, float] = {}
@@ -91,33 +93,51 @@ class LinkMeter:
 
     # --- frames ---
 
-    def arrived(self, seq: int | None = None, sent_ms: float | None = None) -> float | None:
-        """A drive frame has just come in. None if it is out of order (not newer than a frame
-        already seen): the caller drops it. Otherwise how late it is, in seconds (0 without `t`)."""
-        now = self._clock()
+    def arrived(self, seq: int | None = None, sent_ms: float | None = None, now: float | None = None) -> float | None:
+        """A drive frame has just come in: admit() then record()."""
+        if now is None:
+            now = self._clock()
+        late = self.admit(seq, sent_ms, now)
+        if late is not None:
+            self.record(sent_ms, now)
+        return late
+
+    def admit(self, seq: int | None, sent_ms: float | None, now: float) -> float | None:
+        """What the controller must know before it acts on a frame that came in at `now` (this
+        meter's clock): None if it is out of order (not newer than a frame already seen), to be
+        dropped; otherwise how late it is, in seconds (0 without `t`). Then record() it."""
         with self._lock:
-            lost = 0
+            self._lost_before = 0
             if seq is not None:
                 if self._seq is not None:
                     if seq <= self._seq:
                         self.out_of_order += 1
                         return None
-                    lost = seq - self._seq - 1
+                    self._lost_before = seq - self._seq - 1
                 self._seq = seq
+            if sent_ms is None:
+                return 0.0
+            transit = now - sent_ms / 1000.0
+            base = self._base
+            while base and base[-1][1] >= transit:
+                base.pop()
+            base.append((now, transit))
+            while base[0][0] < now - BASE_WINDOW_S:
+                base.popleft()
+            return max(0.0, transit - base[0][1])
+
+    def record(self, sent_ms: float | None, now: float) -> None:
+        """The figures of an admitted frame. Kept apart from admit() so the controller can do
+        this after it has published: measuring never delays a command."""
+        with self._lock:
             self.frames += 1
-            self.lost += lost
-            self._recent.append((now, lost))
+            lost = self._lost_before
+            if lost:
+                self.lost += lost
+            if self._seq is not None:
+                self._recent.append((now, lost))  # only numbered frames tell of losses
             sent_s = None if sent_ms is None else sent_ms / 1000.0
             transit = None if sent_s is None else now - sent_s
-            late = 0.0
-            if transit is not None:
-                base = self._base
-                while base and base[-1][1] >= transit:
-                    base.pop()
-                base.append((now, transit))
-                while base[0][0] < now - BASE_WINDOW_S:
-                    base.popleft()
-                late = max(0.0, transit - base[0][1])
             prev = self._prev
             if prev is not None:
                 p_arrival, p_sent, p_transit = prev
@@ -129,8 +149,6 @@ class LinkMeter:
                     j = self._jitter_s or 0.0  # RFC 3550 starts at zero
                     self._jitter_s = j + (abs(transit - p_transit) - j) * JITTER_GAIN
             self._prev = (now, sent_s, transit)
-            self._forget(now)
-            return late
 
     def idle(self) -> None:
         """The operator let go (a stop frame): the silence that follows is theirs, not the link's."""

@@ -104,17 +104,16 @@ def parse_frame(data: str | bytes, max_bytes: int) -> Drive | Control:
         linear = number(obj, "linear", low=-1.0, high=1.0)
         angular = number(obj, "angular", low=-1.0, high=1.0)
         epoch = obj.get("epoch", 0)
-        if not _whole(epoch):
+        if isinstance(epoch, bool) or not isinstance(epoch, int) or not 0 <= epoch < WHOLE_MAX:
             raise InvalidInput("'epoch' must be a whole number from the server's last state message", "bad_type")
         source = text(obj, "source", default="joystick", choices=SOURCES)
-        seq = obj.get("seq")
-        if "seq" in obj and not _whole(seq):  # null included: absent is the way to send none
-            raise InvalidInput(f"'seq' must be a whole number from 0 to {WHOLE_MAX - 1}", "bad_type")
-        t = number(obj, "t", low=0.0, high=float(WHOLE_MAX)) if "t" in obj else None
+        seq = t = None
+        if "seq" in obj:  # null included: absent is the way to send none
+            seq = obj["seq"]
+            if isinstance(seq, bool) or not isinstance(seq, int) or not 0 <= seq < WHOLE_MAX:
+                raise InvalidInput(f"'seq' must be a whole number from 0 to {WHOLE_MAX - 1}", "bad_type")
+        if "t" in obj:
+            t = number(obj, "t", low=0.0, high=float(WHOLE_MAX))
     except InvalidInput as exc:
         raise FrameError(exc.code, str(exc)) from None
     return Drive(linear, angular, epoch, source, seq, t)
-
-
-def _whole(value) -> bool:
-    return not isinstance(value, bool) and isinstance(value, int) and 0 <= value < WHOLE_MAX

@@ -1,9 +1,9 @@
-"""Teleop sessions (one per socket) and who among them holds control. Pure Python.
+"""Teleop sessions: one per socket, each with its epoch, arming and link. Pure Python.
 
 One operator at a time: the first session to drive holds control; others are view-only until the
-holder releases, disconnects or another session explicitly takes over. The rules that stop the
-robot at a handover are the controller's (control.py); this module keeps the book, always under
-the controller's lock.
+holder releases, disconnects or another session explicitly takes over. Who holds control, and the
+rules that stop the robot at a handover, are the controller's (control.py); this module keeps the
+book of open sessions, always under the controller's lock.
 """
 
 from __future__ import annotations
@@ -38,13 +38,12 @@ class Session:
 
 
 class Sessions:
-    """The open sessions of one controller, and the holder among them."""
+    """The open sessions of one controller, numbered in the order they came."""
 
     def __init__(self, clock: Callable[[], float]):
         self._clock = clock
         self._open: dict[str, Session] = {}
         self._numbers = itertools.count(1)
-        self.holder: Session | None = None
 
     def open(self, name: str | None) -> Session:
         number = next(self._numbers)
@@ -54,12 +53,8 @@ class Sessions:
         return session
 
     def close(self, session: Session) -> bool:
-        """False if it was not open. Whether it held control is the caller's to check first."""
-        if self._open.pop(session.id, None) is None:
-            return False
-        if self.holder is session:
-            self.holder = None
-        return True
+        """False if it was not open."""
+        return self._open.pop(session.id, None) is not None
 
     def is_open(self, session: Session) -> bool:
         return session.id in self._open
