@@ -129,7 +129,12 @@ SETTINGS: tuple[Setting, ...] = (
             "rate at which the server republishes the held joystick/keyboard/REST command on the velocity topic",
             1, 200),
     Setting("TELEOP_DEADMAN_S", 0.3, "float",
-            "a joystick/keyboard command with no fresh input for this long is stopped (zero published)", 0.05, 5),
+            "a joystick/keyboard command with no fresh input for this long is held as it was, then ramps down "
+            "(see TELEOP_DEADMAN_MAX_S)", 0.05, 5),
+    Setting("TELEOP_DEADMAN_MAX_S", 1.0, "float",
+            "hard bound: this long after a joystick/keyboard command's last fresh input zero is published "
+            "whatever happens, the speed ramping down to it from TELEOP_DEADMAN_S (a smaller value is taken "
+            "as TELEOP_DEADMAN_S: hold, then stop)", 0.05, 5),
     Setting("TELEOP_MAX_FRAME_BYTES", 4096, "int",
             "largest teleop WebSocket frame; a bigger one closes the socket with 1009", 256, 65536),
     Setting("TELEOP_WS_PING_S", 10.0, "float",

@@ -1,7 +1,8 @@
 """Teleop: the joystick WebSocket, REST drive commands, the e-stop, and the `teleop` SSE channel.
 
-Thin routes over TeleopController (control.py), which holds every rule (scaling, deadman,
-epochs, one operator at a time, re-arming after an e-stop). Velocity leaves the process only via rover.cmd_vel.
+Thin routes over TeleopController (control.py), which holds every rule (scaling, deadman with
+hold and ramp, epochs, one operator at a time, re-arming after an e-stop). Velocity leaves the
+process only via rover.cmd_vel.
 
   WS   /ws/teleop           joystick and keyboard frames (protocol.py, read by websocket.py)
   GET  /api/teleop          the controller's state (same as the `teleop` channel)
@@ -9,7 +10,8 @@ epochs, one operator at a time, re-arming after an e-stop). Velocity leaves the 
 The e-stop itself is its own feature (rover_web.estop); teleop refuses motion while it is engaged
 and re-arms each socket on release only after a neutral input.
 
-Modules: service (the per-app object), routes, control, protocol, websocket, ws_frames.
+Modules: service (the per-app object), routes, control (the controller) with commands, sessions,
+ramp, link and repeater, protocol (frames), websocket and ws_frames (the socket).
 """
 
 from __future__ import annotations

@@ -1,114 +1,52 @@
-"""The teleop controller: scaling, clamps, deadman, e-stop latch, control ownership, repeater.
+"""The teleop controller: deadman with hold and ramp, e-stop latch, control ownership, the held command.
 
 Pure Python (no Flask, no rclpy). The output is anything with `send(linear_mps, angular_rps)` and
 `zero()` (rover.cmd_vel in the app) and the clocks are injectable, so every rule below is
-unit-tested with a fake clock and a recording output.
+unit-tested with a fake clock and a recording output. Its parts live beside it: commands.py
+(scaling, clamps, the command held, refusals), sessions.py (sockets and who holds control),
+ramp.py (what a command is worth as its input ages), link.py (each socket's link), repeater.py
+(the thread that calls tick()).
 
 Rules, all enforced under one lock so no two threads can interleave a stale command after a stop:
 
 - A joystick/keyboard input is published at once from the thread that received it; the held
   command is then repeated every 1/rate_hz by one repeater thread (`Repeater`), never by browsers.
-- Deadman: a joystick/keyboard command with no fresh input for `deadman_s` is stopped (one zero
-  published, nothing more). The check also runs lazily before every input, so a server that was
-  itself stalled stops first and only then looks at the frames that piled up.
+- Deadman, in three steps (ramp.py): with no fresh input for up to `deadman_s` the last command is
+  held as it was; then the published speed ramps linearly down to zero, reaching it at `deadman_max_s`,
+  the hard bound, when one zero is published and the command ends. A fresh input during the
+  hold or the ramp (same epoch, newer `seq`) takes over at once, with no stop and no new epoch, so a
+  stall that ends does not force a re-arm. A frame's freshness dates from when it was sent
+  (link.py's lateness), not when it came: a frame that waited in a stalled buffer extends nothing.
+  The check also runs lazily before every input, so a server that was itself stalled stops first
+  and only then looks at the frames that piled up.
+- Order: a frame whose `seq` is not newer than one already seen from its socket is dropped, so
+  a late frame never overrides a newer one.
 - Epochs: every socket session has an epoch, starting at 0, that its motion frames must echo.
   A stop the operator did not ask for (deadman, e-stop, takeover, REST stop) bumps the epoch and
   tells the session. Frames sent before the client heard of the stop carry the old epoch and are
   dropped, so frames queued during a stall can never restart the robot; motion resumes only on a
   frame sent after the server's stop notice reached the client, i.e. from a live operator.
-- One operator at a time: the first session to drive holds control; others are view-only until the
-  holder releases, disconnects or another session explicitly takes over.
+- One operator at a time (sessions.py). Disconnecting, releasing, a bad frame, the operator's own
+  stop: zero at once, no hold, no ramp.
 - E-stop: a latch. While engaged only zero is published and every motion request is refused (409).
-- REST commands run for a bounded duration (their own deadman) and only while nobody holds control;
-  a REST `stop` always wins.
+- REST commands run for a bounded duration (their own deadman, no ramp) and only while nobody
+  holds control; a REST `stop` always wins.
 """
 
 from __future__ import annotations
 
-import itertools
 import logging
 import math
-import secrets
 import threading
 import time
-from collections import Counter, deque
+from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import Any
+
+from .commands import REST_COMMANDS, Command, Limits, Refused, scale
+from .ramp import Ramp
+from .sessions import Session, Sessions
 
 log = logging.getLogger(__name__)
-
-# POST /api/teleop commands as (linear, angular) directions; +angular turns left (REP 103).
-REST_COMMANDS: dict[str, tuple[float, float]] = {
-    "forward": (1.0, 0.0), "back": (-1.0, 0.0), "left": (0.0, 1.0), "right": (0.0, -1.0),
-}
-# Where a socket's drive frames come from: the page's own controls. The rules are the same for all;
-# the source is kept in the state (SSE `teleop`) and logged when a socket starts using another.
-SOURCES = ("joystick", "keyboard", "gamepad")
-
-
-@dataclass(frozen=True)
-class Limits:
-    max_linear_mps: float
-    max_angular_rps: float
-
-
-def fraction(value: Any) -> float:
-    """A joystick axis as a fraction in [-1, 1]; anything non-finite or not a number is 0 (stop)."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return 0.0
-    try:
-        value = float(value)
-    except OverflowError:  # an integer too large for a float: no more a number to drive by than inf
-        return 0.0
-    if not math.isfinite(value):
-        return 0.0
-    return max(-1.0, min(1.0, value))
-
-
-def scale(linear: Any, angular: Any, limits: Limits) -> tuple[float, float]:
-    """Joystick fractions to (m/s, rad/s): always finite and within the configured maxima."""
-    return fraction(linear) * limits.max_linear_mps, fraction(angular) * limits.max_angular_rps
-
-
-class Refused(Exception):
-    """A request the controller will not carry out; `status` is the HTTP status it maps to."""
-
-    def __init__(self, code: str, message: str, status: int = 409, **extra: Any):
-        super().__init__(message)
-        self.code, self.message, self.status, self.extra = code, message, status, extra
-
-    def as_frame(self) -> dict:
-        return {"type": "error", "error": self.code, "message": self.message, "status": self.status, **self.extra}
-
-
-@dataclass(eq=False)
-class Session:
-    """One teleop WebSocket. `outbox` holds messages for it; only its own socket thread sends them,
-    woken by `wake()` (set by that thread) as soon as one is queued."""
-
-    id: str
-    name: str
-    epoch: int = 0
-    # False from an e-stop release until this socket sends a neutral input: a stick or key held
-    # through the release must not move the robot the moment the latch opens.
-    armed: bool = True
-    source: str | None = None  # of its last accepted drive frame, so only a change is logged
-    outbox: deque = field(default_factory=lambda: deque(maxlen=64))
-    wake: Callable[[], None] | None = None
-
-    def public(self) -> dict:
-        return {"id": self.id, "name": self.name}
-
-
-@dataclass
-class Command:
-    linear_mps: float
-    angular_rps: float
-    source: str                  # joystick | keyboard | gamepad | rest
-    session: Session | None      # None for REST
-    expires_at: float            # deadman deadline, or the end of a REST command's duration
-
 
 # After a fresh input the first repeat waits a little longer than one period. An input stream at
 # about the repeat rate (a client sending at rate_hz) would otherwise race the repeater at every
@@ -119,6 +57,7 @@ INPUT_REPEAT_DELAY = 1.2
 
 class TeleopController:
     def __init__(self, output, limits: Limits, *, rate_hz: float = 40.0, deadman_s: float = 0.3,
+                 deadman_max_s: float | None = None,
                  clock: Callable[[], float] = time.monotonic, wall_clock: Callable[[], float] = time.time,
                  on_state: Callable[[dict], None] | None = None, estop: dict | None = None,
                  request_estop: Callable[[str], object] | None = None):
@@ -128,30 +67,31 @@ class TeleopController:
         self.rate_hz = rate_hz
         self.period_s = 1.0 / rate_hz
         self.deadman_s = deadman_s
+        # The hard bound is never shorter than the hold: a smaller one means hold, then stop.
+        self.deadman_max_s = max(deadman_s, deadman_max_s if deadman_max_s is not None else deadman_s)
+        self.ramp = Ramp(deadman_s, self.deadman_max_s)
         self._clock = clock
         self._wall = wall_clock
         self._on_state = on_state
         self.request_estop = request_estop  # a socket's {"estop": true}: engages the app's e-stop
-        self._sessions: dict[str, Session] = {}
-        self._holder: Session | None = None
+        self._sessions = Sessions(clock)
+        self._holder: Session | None = None  # holds control (sessions.py); a plain attribute: read on every frame
         self._command: Command | None = None
         self._next_tick = math.inf
+        self._ramping = False  # the last value published was the held command ramped down
         self._estop = {"engaged": False, "since": None, "by": None}
         if estop:
             self._estop.update({k: estop[k] for k in ("engaged", "since", "by") if k in estop})
         self._last_stop: dict | None = None
         self._closed = False
         self._shown: dict | None = None
-        self._numbers = itertools.count(1)
         self.stats: Counter = Counter()
 
     # --- sessions and control ---
 
     def connect(self, name: str | None = None) -> Session:
         with self._cond:
-            number = next(self._numbers)
-            session = Session(id=f"{number}-{secrets.token_hex(3)}", name=name or f"operator {number}")
-            self._sessions[session.id] = session
+            session = self._sessions.open(name)
             self._changed()
             return session
 
@@ -159,7 +99,7 @@ class TeleopController:
         """The socket closed or failed: if it held control, zero at once and free control."""
         with self._cond:
             self._expire(self._clock())
-            if self._sessions.pop(session.id, None) is None:
+            if not self._sessions.close(session):
                 return
             if self._holder is session:
                 self._holder = None
@@ -199,53 +139,87 @@ class TeleopController:
     # --- motion ---
 
     def drive(self, session: Session, linear: float, angular: float, *, epoch: int = 0,
-              source: str = "joystick") -> tuple[float, float]:
-        """A joystick/keyboard/gamepad input (fractions of the maxima). Published at once if it changed."""
-        with self._cond:
-            now = self._clock()
-            self._expire(now)  # a stalled server stops first, then judges the frames that piled up
-            self._require_open(session)
-            if self._estop["engaged"]:
-                raise Refused("estop_engaged", "the e-stop is engaged: release it (POST /api/estop "
-                              '{"engaged": false}) before driving')
-            if not session.armed:
-                if linear or angular:
-                    raise Refused("rearm_required", f"the robot was stopped ({self._last_stop_reason()}) while "
-                                  "this input was held: release the stick (or key) to re-arm, then drive")
-                session.armed = True
-            if epoch != session.epoch:
-                self.stats["stale_dropped"] += 1
-                raise Refused("stale_epoch", f"frame for epoch {epoch} dropped: the robot was stopped "
-                              f"({self._last_stop_reason()}); send epoch {session.epoch} to drive again",
-                              epoch=session.epoch)
-            if self._holder is None:
-                self._holder = session
-                self._tell(session, "in_control")
-            elif self._holder is not session:
-                raise Refused("not_in_control", f"{self._holder.name} holds control; you are view-only "
-                              'until they release it or you send {"takeover": true}',
-                              holder=self._holder.public())
-            new_source = source != session.source  # logged once per change, not per frame
-            session.source = source
-            linear_mps, angular_rps = scale(linear, angular, self.limits)
-            previous = self._command
-            self._command = Command(linear_mps, angular_rps, source, session, now + self.deadman_s)
-            if (previous is None or previous.session is not session
-                    or (previous.linear_mps, previous.angular_rps) != (linear_mps, angular_rps)):
-                self._publish(linear_mps, angular_rps)
-                self._next_tick = now + self.period_s * INPUT_REPEAT_DELAY
-            self.stats["inputs"] += 1
-            self._changed()
-            self._cond.notify_all()
-        if new_source:  # after the publish and outside the lock: the log's I/O never delays a command
+              source: str = "joystick", seq: int | None = None, sent_ms: float | None = None) -> tuple[float, float]:
+        """A joystick/keyboard/gamepad input (fractions of the maxima). Published at once if it changed.
+
+        `seq` and `sent_ms` (the client's send time, on its own millisecond clock) are optional:
+        without them a frame is in order and as fresh as its arrival."""
+        now = None
+        try:
+            with self._cond:
+                now = self._clock()
+                self._expire(now)  # a stalled server stops first, then judges the frames that piled up
+                self._require_open(session)
+                late_s = session.link.admit(seq, sent_ms, now)  # the meter has this controller's clock
+                if late_s is None:
+                    now = None  # dropped, and not measured either
+                    self.stats["out_of_order_dropped"] += 1
+                    raise Refused("stale_seq", f"frame {seq} dropped: a newer frame from this socket came first")
+                command = self._drive(session, linear, angular, epoch, late_s, now)
+                new_source = source != session.source  # logged once per change, not per frame
+                session.source = source
+                command.source = source
+                self._changed()
+                self._cond.notify_all()
+        finally:
+            # After the publish and outside the lock: measuring never delays a command, and
+            # frames refused for their content or their epoch still tell of the link.
+            if now is not None:
+                session.link.record(sent_ms, now)
+        if new_source:  # the log's I/O never delays a command either
             log.info("teleop: %s drives with the %s", session.name, source)
-        return linear_mps, angular_rps
+        return command.linear_mps, command.angular_rps
+
+    def _drive(self, session: Session, linear: float, angular: float, epoch: int, late_s: float,
+               now: float) -> Command:
+        """The rules for an admitted drive frame, with the lock held: the command it sets (published
+        at once if it changed), or Refused."""
+        if self._estop["engaged"]:
+            raise Refused("estop_engaged", "the e-stop is engaged: release it (POST /api/estop "
+                          '{"engaged": false}) before driving')
+        if not session.armed:
+            if linear or angular:
+                raise Refused("rearm_required", f"the robot was stopped ({self._last_stop_reason()}) while "
+                              "this input was held: release the stick (or key) to re-arm, then drive")
+            session.armed = True
+        if epoch != session.epoch:
+            self.stats["stale_dropped"] += 1
+            raise Refused("stale_epoch", f"frame for epoch {epoch} dropped: the robot was stopped "
+                          f"({self._last_stop_reason()}); send epoch {session.epoch} to drive again",
+                          epoch=session.epoch)
+        if late_s >= self.deadman_max_s:  # its input is past the bound already (ramp.expired)
+            self.stats["late_dropped"] += 1
+            raise Refused("late_frame", f"frame dropped: it arrived {1000 * late_s:.0f} ms late, past the "
+                          f"{1000 * self.deadman_max_s:.0f} ms any input may drive for")
+        if self._holder is None:
+            self._holder = session
+            self._tell(session, "in_control")
+        elif self._holder is not session:
+            raise Refused("not_in_control", f"{self._holder.name} holds control; you are view-only "
+                          'until they release it or you send {"takeover": true}',
+                          holder=self._holder.public())
+        linear_mps, angular_rps = scale(linear, angular, self.limits)
+        previous = self._command
+        fresh_at = now - late_s
+        self._command = command = Command(linear_mps, angular_rps, "", session, fresh_at,
+                                          fresh_at + self.deadman_max_s)
+        if late_s > self.deadman_s:  # came in so late that its own value is already easing off
+            self._publish_command(now)
+            self._next_tick = now + self.period_s * INPUT_REPEAT_DELAY
+        elif (previous is None or previous.session is not session or self._ramping
+                or (previous.linear_mps, previous.angular_rps) != (linear_mps, angular_rps)):
+            self._ramping = False
+            self._publish(linear_mps, angular_rps)
+            self._next_tick = now + self.period_s * INPUT_REPEAT_DELAY
+        self.stats["inputs"] += 1
+        return command
 
     def stop(self, session: Session, reason: str = "operator") -> bool:
         """The holder's own stop (stick released, key up, tab hidden). A viewer's stop is ignored."""
         with self._cond:
             self._expire(self._clock())
             session.armed = True  # a stop is the neutral input that re-arms after an e-stop
+            session.link.idle()
             if self._holder is not None and self._holder is not session:
                 return False
             self._stop(reason)
@@ -268,8 +242,8 @@ class TeleopController:
                               holder=self._holder.public())
             direction = REST_COMMANDS[command]
             linear_mps, angular_rps = scale(direction[0] * speed, direction[1] * speed, self.limits)
-            self._command = Command(linear_mps, angular_rps, "rest", None, now + duration_s)
-            self._publish(linear_mps, angular_rps)
+            self._command = Command(linear_mps, angular_rps, "rest", None, now, now + duration_s)
+            self._publish_command(now)
             self._next_tick = now + self.period_s
             self._changed()
             self._cond.notify_all()
@@ -294,7 +268,7 @@ class TeleopController:
         with self._cond:
             if not self._estop["engaged"]:
                 self._estop = {"engaged": True, "since": self._wall(), "by": by}
-            self._stop("estop", bump=list(self._sessions.values()), always=True)
+            self._stop("estop", bump=list(self._sessions), always=True)
             self._changed()
             return dict(self._estop)
 
@@ -304,9 +278,9 @@ class TeleopController:
         command the operator gave before it vanished."""
         with self._cond:
             held = self._command is not None
-            for session in self._sessions.values():
+            for session in self._sessions:
                 session.armed = False
-            self._stop("link_lost", bump=list(self._sessions.values()))
+            self._stop("link_lost", bump=list(self._sessions))
             if held:
                 self._changed()
 
@@ -314,7 +288,7 @@ class TeleopController:
         with self._cond:
             if self._estop["engaged"]:
                 self._estop = {"engaged": False, "since": self._wall(), "by": by}
-                for session in self._sessions.values():
+                for session in self._sessions:
                     session.armed = False
                     self._tell(session, "estop_released")
                 self._changed()
@@ -323,7 +297,8 @@ class TeleopController:
     # --- the repeater's side ---
 
     def tick(self) -> float | None:
-        """Enforce deadlines and repeat the held command when due; the next wake-up time or None."""
+        """Enforce deadlines and repeat the held command (ramped, if its input is going stale) when
+        due; the next wake-up time or None."""
         with self._cond:
             now = self._clock()
             self._expire(now)
@@ -331,11 +306,14 @@ class TeleopController:
             if command is None:
                 return None
             if now >= self._next_tick:
-                self._publish(command.linear_mps, command.angular_rps)
+                ramping = self._ramping
+                self._publish_command(now)
                 self.stats["repeated"] += 1
                 self._next_tick += self.period_s  # a fixed grid: late wake-ups do not lower the rate
                 if self._next_tick <= now:
                     self._next_tick = now + self.period_s
+                if ramping != self._ramping:
+                    self._changed()
             return min(self._next_tick, command.expires_at)
 
     def close(self) -> None:
@@ -364,7 +342,7 @@ class TeleopController:
     def _require_open(self, session: Session) -> None:
         if self._closed:
             raise Refused("shutting_down", "the server is shutting down", status=503)
-        if session.id not in self._sessions:
+        if not self._sessions.is_open(session):
             raise Refused("disconnected", "this session is closed; reconnect", status=410)
 
     def _expire(self, now: float) -> None:
@@ -386,6 +364,7 @@ class TeleopController:
             self._publish_zero()
             self._last_stop = {"reason": reason, "at": round(self._wall(), 3)}
         self._command = None
+        self._ramping = False
         self._next_tick = math.inf
         for session in bump:
             if session is not None:
@@ -402,7 +381,18 @@ class TeleopController:
         holder = self._holder
         return {"type": "state", "epoch": session.epoch, "in_control": holder is session,
                 "holder": holder.public() if holder else None, "estop": self._estop["engaged"],
-                "armed": session.armed, "reason": reason}
+                "armed": session.armed, "reason": reason, "link": session.link.snapshot()}
+
+    def _publish_command(self, now: float) -> None:
+        """The held command as it stands now: a REST command as given, a socket's ramped by age."""
+        command = self._command
+        if command.session is None:
+            self._ramping = False
+            self._publish(command.linear_mps, command.angular_rps)
+            return
+        factor = self.ramp.factor(now - command.fresh_at)
+        self._ramping = factor < 1.0
+        self._publish(command.linear_mps * factor, command.angular_rps * factor)
 
     def _publish(self, linear_mps: float, angular_rps: float) -> None:
         if self._closed:
@@ -433,6 +423,7 @@ class TeleopController:
             "linear_mps": round(command.linear_mps, 4) if command else 0.0,
             "angular_rps": round(command.angular_rps, 4) if command else 0.0,
             "moving": bool(command and (command.linear_mps or command.angular_rps)),
+            "ramping": self._ramping,
             "source": command.source if command else None,
             "holder": holder.public() if holder else None,
             "operators": len(self._sessions),
@@ -442,6 +433,7 @@ class TeleopController:
             "max_angular_rps": self.limits.max_angular_rps,
             "rate_hz": self.rate_hz,
             "deadman_s": self.deadman_s,
+            "deadman_max_s": self.deadman_max_s,
         }
 
     def _changed(self) -> None:
@@ -454,41 +446,3 @@ class TeleopController:
                 self._on_state(state)
             except Exception:
                 log.exception("teleop state listener failed")
-
-
-class Repeater:
-    """The one thread that repeats the held command and enforces deadlines, waking exactly when due.
-
-    It sleeps on the controller's condition until the next tick or deadline, whichever is first;
-    every input notifies it so it re-plans at once. Idle (nothing held), it waits without a timeout.
-    """
-
-    def __init__(self, controller: TeleopController):
-        self.controller = controller
-        self._thread = threading.Thread(target=self._run, name="teleop-repeater", daemon=True)
-
-    def start(self) -> Repeater:
-        self._thread.start()
-        return self
-
-    def _run(self) -> None:
-        c = self.controller
-        with c._cond:
-            while not c._closed:
-                try:
-                    wake_at = c.tick()
-                except Exception:  # pragma: no cover - a bug; keep enforcing the deadman anyway
-                    log.exception("teleop repeater tick failed")
-                    wake_at = c._clock() + c.period_s
-                timeout = None if wake_at is None else max(0.0, wake_at - c._clock())
-                if timeout is None or timeout > 0:
-                    c._cond.wait(timeout)
-
-    def stop(self, timeout_s: float = 2.0) -> None:
-        self.controller.close()
-        if self._thread.is_alive():
-            self._thread.join(timeout_s)
-
-    @property
-    def alive(self) -> bool:
-        return self._thread.is_alive()

@@ -1,13 +1,17 @@
 """What a teleop WebSocket frame may say, parsed strictly. Pure Python.
 
 Client -> server, one JSON object per text frame:
-  {"linear": f, "angular": f, "epoch": n, "source": "joystick"|"keyboard"|"gamepad"}  drive; f in [-1, 1]
+  {"linear": f, "angular": f, "epoch": n, "source": "joystick"|"keyboard"|"gamepad", "seq": n, "t": ms}
+                        drive; f in [-1, 1]
   {"stop": true}        the operator's own stop (stick released, key up, tab hidden)
   {"takeover": true}    take control from whoever holds it
   {"release": true}     give control back
   {"estop": true}       engage the e-stop (any socket, driving or not): the page's fastest way to stop
 `epoch` (default 0) is the number from the server's latest "hello"/"state" message; `source`
-defaults to "joystick".
+defaults to "joystick". `seq` (a whole number that grows with every drive frame of the socket) and
+`t` (the client's send time in milliseconds on any clock of its own that does not jump, such as
+performance.now()) are optional: with them the server drops frames that come out of order and
+measures the link (link.py); a client without them works as before.
 
 Bad frames: a frame over the size limit closes the socket with 1009, a binary frame with 1003,
 a frame that is not JSON at all with 1007. A JSON frame with wrong content (non-finite numbers,
@@ -23,7 +27,7 @@ import orjson
 
 from rover_web.web.validate import InvalidInput, json_type, loads_strict, number, only_keys, text
 
-from .control import SOURCES
+from .commands import SOURCES
 
 CLOSE_UNSUPPORTED_DATA = 1003
 CLOSE_INVALID_PAYLOAD = 1007
@@ -46,6 +50,8 @@ class Drive(NamedTuple):  # a tuple: built 40 times a second, and cheaper than a
     angular: float
     epoch: int = 0
     source: str = "joystick"
+    seq: int | None = None
+    t: float | None = None  # the client's send time, ms
 
 
 class Control(NamedTuple):
@@ -53,7 +59,8 @@ class Control(NamedTuple):
 
 
 CONTROL_ACTIONS = ("stop", "takeover", "release", "estop")
-DRIVE_KEYS = {"linear", "angular", "epoch", "source"}
+DRIVE_KEYS = {"linear", "angular", "epoch", "source", "seq", "t"}
+WHOLE_MAX = 2**53  # the largest whole number a browser's JSON numbers hold exactly
 
 
 def _loads(data: str):
@@ -97,9 +104,16 @@ def parse_frame(data: str | bytes, max_bytes: int) -> Drive | Control:
         linear = number(obj, "linear", low=-1.0, high=1.0)
         angular = number(obj, "angular", low=-1.0, high=1.0)
         epoch = obj.get("epoch", 0)
-        if isinstance(epoch, bool) or not isinstance(epoch, int) or not 0 <= epoch < 2**53:
+        if isinstance(epoch, bool) or not isinstance(epoch, int) or not 0 <= epoch < WHOLE_MAX:
             raise InvalidInput("'epoch' must be a whole number from the server's last state message", "bad_type")
         source = text(obj, "source", default="joystick", choices=SOURCES)
+        seq = t = None
+        if "seq" in obj:  # null included: absent is the way to send none
+            seq = obj["seq"]
+            if isinstance(seq, bool) or not isinstance(seq, int) or not 0 <= seq < WHOLE_MAX:
+                raise InvalidInput(f"'seq' must be a whole number from 0 to {WHOLE_MAX - 1}", "bad_type")
+        if "t" in obj:
+            t = number(obj, "t", low=0.0, high=float(WHOLE_MAX))
     except InvalidInput as exc:
         raise FrameError(exc.code, str(exc)) from None
-    return Drive(linear, angular, epoch, source)
+    return Drive(linear, angular, epoch, source, seq, t)

@@ -8,7 +8,9 @@ from rover_web.config import ConfigError
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
 
-from .control import Limits, Repeater, TeleopController
+from .commands import Limits
+from .control import TeleopController
+from .repeater import Repeater
 
 log = logging.getLogger(__name__)
 
@@ -29,6 +31,7 @@ class TeleopService:
             rover.cmd_vel,
             Limits(config["ROVER_WEB_MAX_LINEAR_MPS"], config["ROVER_WEB_MAX_ANGULAR_RPS"]),
             rate_hz=config["ROVER_WEB_TELEOP_RATE_HZ"], deadman_s=config["ROVER_WEB_TELEOP_DEADMAN_S"],
+            deadman_max_s=config["ROVER_WEB_TELEOP_DEADMAN_MAX_S"],
             on_state=lambda state: hub.publish_throttled(CHANNEL, state, CHANNEL_MAX_HZ),
             estop=estop.state(), request_estop=lambda by: estop.engage(by, via="websocket"))
         # The e-stop service owns the latch; the controller keeps a copy to refuse drive frames
@@ -42,6 +45,7 @@ class TeleopService:
     def hello(self) -> dict:
         deadman_s = self.controller.deadman_s
         return {"rate_hz": self.controller.rate_hz, "deadman_s": deadman_s,
+                "deadman_max_s": self.controller.deadman_max_s,
                 # how often a client should repeat a held input: three chances per deadman period
                 "keepalive_s": round(min(0.1, deadman_s / 3), 3),
                 "max_linear_mps": self.controller.limits.max_linear_mps,

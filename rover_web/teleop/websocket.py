@@ -11,7 +11,9 @@ saw it.
 
 The request thread (`TeleopSocket.serve`) keeps what may wait: every message to the client (hello,
 state changes, error replies), the pings, and the close handshake. A client that has not
-answered one ping by the next loses the socket (1008) and control.
+answered one ping by the next loses the socket (1008) and control. Every LINK_S it also sends a
+ping carrying an id, whose pong gives the round trip (link.py), and a `state` frame with the
+link's figures (`reason: "link"`), so the page shows the link even while nothing changes.
 
 No extension is agreed (routes.py drops the offer before the handshake): permessage-deflate on
 ~50-byte frames saves nothing and costs both ends zlib work on every frame.
@@ -50,6 +52,8 @@ RECEIVE_BYTES = 4096
 POLL_S = 0.05
 # How long a client has to answer our close frame before the connection is cut.
 CLOSE_GRACE_S = 0.5
+# How often a socket gets a measuring ping and a `state` frame with its link's figures.
+LINK_S = 0.5
 
 
 class FrameReader(threading.Thread):
@@ -89,7 +93,8 @@ def handle_frame(controller: TeleopController, session: Session, data, max_bytes
         return exc.as_frame()
     try:
         if isinstance(frame_, Drive):
-            controller.drive(session, frame_.linear, frame_.angular, epoch=frame_.epoch, source=frame_.source)
+            controller.drive(session, frame_.linear, frame_.angular, epoch=frame_.epoch, source=frame_.source,
+                             seq=frame_.seq, sent_ms=frame_.t)
         elif isinstance(frame_, Control) and frame_.action == "stop":
             controller.stop(session, "operator")
         elif frame_.action == "takeover":
@@ -126,16 +131,22 @@ class TeleopSocket:
 
     # --- the request thread ---
 
-    def serve(self, hello: dict, stopping: threading.Event, ping_s: float | None = None) -> None:
+    def serve(self, hello: dict, stopping: threading.Event, ping_s: float | None = None,
+              link_s: float | None = LINK_S) -> None:
         """Runs in the request thread until the socket ends or the server stops."""
         session = self.session
         next_ping = time.monotonic() + ping_s if ping_s else math.inf
+        next_link = time.monotonic() if link_s else math.inf
         try:
             self._send(hello)
             self.reader.attach(self)
             while not stopping.is_set():
-                self._wake.wait(max(0.0, min(POLL_S, next_ping - time.monotonic())))
+                self._wake.wait(max(0.0, min(POLL_S, next_ping - time.monotonic(), next_link - time.monotonic())))
                 self._wake.clear()
+                if time.monotonic() >= next_link and not self._close_sent:
+                    self._write(frame(OP_PING, session.link.ping()))
+                    session.outbox.append(self.controller.session_state(session, "link"))
+                    next_link = time.monotonic() + link_s
                 while session.outbox and not self._close_sent:
                     self._send(session.outbox.popleft())
                 if self._close is not None:
@@ -227,7 +238,10 @@ class TeleopSocket:
                     elif kind == "ping":
                         self._write(frame(OP_PONG, body))
                     elif kind == "pong":
-                        self.pong_received = True
+                        if body:  # the answer to a measuring ping (LINK_S); the empty ones keep us alive
+                            self.session.link.pong(body)
+                        else:
+                            self.pong_received = True
                     else:  # close: answer it (unless it answers ours) and stop reading
                         code = body[0]
                         self._send_close(CLOSE_NORMAL if code == CLOSE_NO_STATUS else code, "")

@@ -12,6 +12,7 @@ import { operatorName, setOperatorName } from './operator.js';
 import { startGamepad } from './teleop_gamepad.js';
 import { setEstopSender } from './teleop_link.js';
 import { teleopChannel } from './camera/teleop_channel.js';
+import { linkView } from './teleop/link_view.js';
 
 const card = document.getElementById('teleop-card');
 if (card) start();
@@ -39,6 +40,8 @@ function start() {
   let driving = false;         // a drive frame went out since the last stop
   let sentAt = -Infinity;      // when the last drive frame went out (performance.now())
   let periodMs = 25;           // the server's repeat period, 1 / rate_hz
+  let seq = 0;                 // numbers this socket's drive frames, so the server drops any that come late
+  const linkFigures = linkView();
 
   const clamp = (v) => (Number.isFinite(v) ? Math.max(-1, Math.min(1, v)) : 0);
   const round = (v) => Math.round(clamp(v) * 1000) / 1000;
@@ -83,7 +86,13 @@ function start() {
   function sendDrive() {
     const cmd = wanted();
     if (!cmd || !mayDrive()) return;
-    send({ linear: round(cmd.linear), angular: round(cmd.angular), epoch, source: cmd.source });
+    // t: when it left, on this page's monotonic clock; the server measures jitter and stalls from it
+    // and dates the frame's freshness from it (docs/teleop.md).
+    seq += 1;
+    send({
+      linear: round(cmd.linear), angular: round(cmd.angular), epoch, source: cmd.source,
+      seq, t: Math.round(performance.now() * 10) / 10,
+    });
     driving = true;
     sentAt = performance.now();
   }
@@ -147,6 +156,8 @@ function start() {
       link.dataset.transport = m.transport || 'websocket';  // the camera's data channel, when it is up
       link.textContent = `connected as ${m.name}${m.transport === 'datachannel' ? ' (data channel)' : ''}`;
     }
+    if (m.link) linkFigures.show(m.link);
+    if (m.type === 'state' && m.reason === 'link') return;  // the periodic report: nothing changed
     if (m.type === 'hello' || m.type === 'state') {
       epoch = m.epoch;
       inControl = m.in_control;
@@ -162,7 +173,7 @@ function start() {
       if (wanted()) sendDrive();  // still held: the new epoch makes this a fresh, live input
     } else if (m.type === 'error' && m.error === 'rearm_required') {
       message('E-stop released: let go of the stick, keys or gamepad to re-arm.');
-    } else if (m.type === 'error' && m.error !== 'stale_epoch') {
+    } else if (m.type === 'error' && !['stale_epoch', 'stale_seq', 'late_frame'].includes(m.error)) {
       message(m.message);
     }
   }
@@ -177,6 +188,7 @@ function start() {
     const scheme = location.protocol === 'https:' ? 'wss:' : 'ws:';
     ws = teleopChannel.socket()
       || new WebSocket(`${scheme}//${location.host}${base}/ws/teleop?name=${encodeURIComponent(operatorName())}`);
+    seq = 0;  // a new socket (or data channel) is a new session on the server
     ws.onmessage = (ev) => {
       let m;
       try { m = JSON.parse(ev.data); } catch { return; }
@@ -189,6 +201,7 @@ function start() {
       const link = $('teleop-link');
       link.dataset.state = 'reconnecting';
       link.textContent = 'reconnecting';
+      linkFigures.clear();
       render();
       setTimeout(connect, retryMs);
       retryMs = Math.min(retryMs * 2, 5000);

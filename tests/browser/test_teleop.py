@@ -5,10 +5,12 @@ releasing the stick, hiding the tab, blurring the window or leaving the page was
 itself (or, leaving the page, by its socket closing), not by the server timing out.
 """
 
+import json
 import time
 
 import pytest
 
+from tests.support.delay_proxy import DelayProxy
 from tests.support.teleop_support import is_zero, subscribe_cmd_vel, twists, warm_up
 
 pytestmark = pytest.mark.browser
@@ -252,3 +254,51 @@ def test_second_browser_is_view_only_and_can_take_over(rig, browser):
     finally:
         ctx_a.close()
         ctx_b.close()
+
+
+def test_the_drive_card_shows_the_link_and_says_plainly_when_it_is_too_poor(rig, page):
+    """The page goes through a proxy whose delay is turned up once it is live: the server's own
+    measurement of the page's socket (pings the browser answers) reaches the card, and so does the
+    verdict. The page's drive frames carry seq and t."""
+    server, peer = rig
+    proxy = DelayProxy(server.port)
+    sent = []
+    page.on("websocket", lambda ws: ws.on("framesent", lambda payload: sent.append(payload)))
+    try:
+        page.goto(proxy.url + "/")
+        page.wait_for_selector("#teleop-link[data-state='live']", timeout=10000)
+        page.wait_for_function("document.getElementById('teleop-rtt').textContent.endsWith(' ms')", timeout=10000)
+        linkq = page.locator("#teleop-linkq")
+        page.wait_for_selector("#teleop-linkq[data-quality='ok'], #teleop-linkq[data-quality='poor']", timeout=10000)
+        assert page.locator("#teleop-stalls").inner_text() != "—"
+        assert page.locator("#teleop-link-banner").is_hidden()
+
+        press_stick(page)
+        wait_moving(peer)
+        time.sleep(0.3)  # a few keep-alives
+        page.mouse.up()
+        peer.wait_for("/cmd_vel", is_zero, timeout=2.0)
+        drives = [json.loads(f) for f in sent if '"linear"' in f]
+        assert len(drives) >= 3
+        seqs = [d["seq"] for d in drives]
+        assert seqs == sorted(set(seqs)) and all(isinstance(d["t"], (int, float)) for d in drives)
+        assert [d["t"] for d in drives] == sorted(d["t"] for d in drives)
+        page.wait_for_function("document.getElementById('teleop-jitter').textContent.endsWith(' ms')",
+                               timeout=5000)
+
+        proxy.delay_s = 0.45  # each way: a 900 ms round trip
+        banner = page.locator("#teleop-link-banner")
+        banner.wait_for(state="visible", timeout=20000)
+        text = banner.inner_text()
+        assert text.startswith("Link too poor to drive safely: ") and text.endswith(" ms round trip"), text
+        assert int(text.split(": ")[1].split(" ")[0]) >= 600
+        page.wait_for_selector("#teleop-linkq[data-quality='too_poor']", timeout=5000)
+        page.wait_for_function("document.getElementById('teleop-quality').textContent === 'too poor' && "
+                               "parseInt(document.getElementById('teleop-rtt').textContent) >= 800", timeout=10000)
+
+        proxy.delay_s = 0.0  # the link recovers: so does the card
+        banner.wait_for(state="hidden", timeout=30000)
+        assert linkq.get_attribute("data-quality") in ("ok", "poor")
+        assert page.watch.console_errors == []
+    finally:
+        proxy.close()

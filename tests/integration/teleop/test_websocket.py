@@ -94,17 +94,22 @@ def test_socket_closed_mid_drive_stops_within_100_ms(rig, how):
     assert server.rover.hub.latest("teleop")["holder"] is None  # control freed
 
 
-def test_silence_mid_drive_stops_within_deadman_plus_50_ms(rig):
+def test_silence_mid_drive_holds_then_ramps_then_stops_by_the_hard_bound(rig):
+    """The operator's input stops with the socket still open: the last command is held for the
+    deadman, eased off, and zero goes out by the hard bound (a bound, asserted with a margin)."""
     server, peer = rig()
     client = TeleopClient(server.url)
-    deadman_s = client.hello["deadman_s"]
-    assert deadman_s == 0.3
+    deadman_s, deadman_max_s = client.hello["deadman_s"], client.hello["deadman_max_s"]
+    assert (deadman_s, deadman_max_s) == (0.3, 1.0)
     times = drive_at(client, [(0.3, 0.0), (0.4, 0.0)] * 10)
     t_last = times[-1]  # then the operator's input stops, with the socket still open
-    zero = peer.wait_for("/cmd_vel", is_zero, timeout=2.0)
-    assert zero["t"] - t_last <= deadman_s + 0.050, zero["t"] - t_last
-    moving = [t for t, lin, _ in twists(peer) if lin]
-    assert moving[-1] - t_last >= deadman_s - 0.05  # the held command was repeated until the deadman
+    zero = peer.wait_for("/cmd_vel", is_zero, timeout=5.0)
+    assert zero["t"] - t_last <= deadman_max_s + 0.5, zero["t"] - t_last
+    after = [(t, lin) for t, lin, _ in twists(peer) if t_last < t < zero["t"]]
+    assert after and all(0 < lin <= 2.0 for _, lin in after)  # never above the last command
+    speeds = [lin for t, lin in after if t > t_last + 0.1]
+    assert speeds == sorted(speeds, reverse=True)  # only ever toward zero
+    assert any(lin < 2.0 for lin in speeds)  # it eased off before the stop
     time.sleep(0.6)
     assert all(lin == 0.0 for t, lin, _ in twists(peer) if t >= zero["t"])
     state = client.wait_for(lambda m: m["type"] == "state" and m["reason"] == "deadman")

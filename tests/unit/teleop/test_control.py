@@ -4,7 +4,9 @@ import math
 
 import pytest
 
-from rover_web.teleop.control import INPUT_REPEAT_DELAY, Limits, Refused, Repeater, TeleopController, fraction, scale
+from rover_web.teleop.commands import Limits, Refused, fraction, scale
+from rover_web.teleop.control import INPUT_REPEAT_DELAY, TeleopController
+from rover_web.teleop.repeater import Repeater
 
 LIMITS = Limits(5.0, 2.0)
 

@@ -13,7 +13,8 @@ from hypothesis import strategies as st
 
 from rover_web.ros.cmd_vel import clamp
 from rover_web.ros.convert import twist_message
-from rover_web.teleop.control import Limits, Refused, TeleopController
+from rover_web.teleop.commands import Limits, Refused
+from rover_web.teleop.control import TeleopController
 from rover_web.teleop.protocol import Drive, FrameError, parse_frame
 
 MAX_BYTES = 4096
@@ -36,7 +37,8 @@ frames = st.one_of(
     st.fixed_dictionaries({"linear": values, "angular": values}).map(to_text),
     st.fixed_dictionaries({"linear": numbers, "angular": numbers},
                           optional={"epoch": st.integers(0, 3),
-                                    "source": st.sampled_from(["joystick", "keyboard", "x"])}
+                                    "source": st.sampled_from(["joystick", "keyboard", "x"]),
+                                    "seq": st.one_of(st.integers(-1, 10), numbers), "t": numbers}
                           ).map(to_text),
     st.dictionaries(st.sampled_from(["linear", "angular", "stop", "epoch", "z"]), values, max_size=4).map(to_text),
     st.text(max_size=40),
@@ -80,7 +82,8 @@ def test_published_twists_are_finite_bounded_and_planar(batch, max_linear, max_a
         if isinstance(frame, Drive):
             assert -1 <= frame.linear <= 1 and -1 <= frame.angular <= 1
             try:
-                ctl.drive(session, frame.linear, frame.angular, epoch=frame.epoch, source=frame.source)
+                ctl.drive(session, frame.linear, frame.angular, epoch=frame.epoch, source=frame.source,
+                          seq=frame.seq, sent_ms=frame.t)
             except Refused:
                 pass
         ctl.tick()

@@ -20,6 +20,9 @@ def test_drive_frames():
         Drive(0.0, 0.0, 3, "keyboard")
     assert parse_frame('{"linear": -0.25, "angular": 1, "epoch": 2, "source": "gamepad"}', MAX) == \
         Drive(-0.25, 1.0, 2, "gamepad")
+    assert parse_frame('{"linear": 0.5, "angular": 0, "seq": 17, "t": 123456.789}', MAX) == \
+        Drive(0.5, 0.0, 0, "joystick", 17, 123456.789)
+    assert parse_frame('{"linear": 0.5, "angular": 0, "seq": 0, "t": 0}', MAX) == Drive(0.5, 0.0, seq=0, t=0.0)
 
 
 @pytest.mark.parametrize("action", ["stop", "takeover", "release"])
@@ -44,6 +47,20 @@ def test_control_frames(action):
     ('{"linear": 0, "angular": 0, "epoch": 1.5}', "bad_type"),
     ('{"linear": 0, "angular": 0, "source": "joypad"}', "bad_value"),
     ('{"linear": 0, "angular": 0, "source": "Gamepad"}', "bad_value"),
+    ('{"linear": 0, "angular": 0, "seq": -1}', "bad_type"),
+    ('{"linear": 0, "angular": 0, "seq": 1.5}', "bad_type"),
+    ('{"linear": 0, "angular": 0, "seq": true}', "bad_type"),
+    ('{"linear": 0, "angular": 0, "seq": null}', "bad_type"),
+    ('{"linear": 0, "angular": 0, "seq": "3"}', "bad_type"),
+    ('{"linear": 0, "angular": 0, "seq": 9007199254740992}', "bad_type"),
+    ('{"linear": 0, "angular": 0, "t": "12"}', "bad_type"),
+    ('{"linear": 0, "angular": 0, "t": null}', "bad_type"),
+    ('{"linear": 0, "angular": 0, "t": false}', "bad_type"),
+    ('{"linear": 0, "angular": 0, "t": -0.5}', "out_of_range"),
+    ('{"linear": 0, "angular": 0, "t": 1e300}', "out_of_range"),
+    ('{"linear": 0, "angular": 0, "t": NaN}', "non_finite"),
+    ('{"linear": 0, "angular": 0, "t": 1e400}', "non_finite"),
+    ('{"stop": true, "seq": 3}', "unknown_field"),
     ('{"stop": false}', "bad_value"),
     ('{"stop": true, "linear": 1}', "unknown_field"),
     ('[0.5, 0.5]', "bad_frame"),
@@ -89,15 +106,17 @@ json_numbers = st.one_of(
 json_values = st.recursive(
     st.one_of(json_numbers, st.booleans(), st.none(), st.text(max_size=8)),
     lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=6), inner, max_size=3), max_leaves=8)
-frame_keys = st.sampled_from(["linear", "angular", "epoch", "source", "stop", "takeover", "release", "x", "\ud800"])
+frame_keys = st.sampled_from(["linear", "angular", "epoch", "source", "seq", "t", "stop", "takeover", "release", "x",
+                              "\ud800"])
 frame_texts = st.one_of(
     st.dictionaries(frame_keys, json_values, max_size=5).map(json.dumps),
     st.fixed_dictionaries({"linear": json_numbers, "angular": json_numbers},
-                          optional={"epoch": json_numbers,
+                          optional={"epoch": json_numbers, "seq": json_numbers, "t": json_numbers,
                                     "source": st.sampled_from(["joystick", "keyboard", "gamepad", "\ud800"])}
                           ).map(json.dumps),
     json_values.map(json.dumps),
-    st.tuples(st.sampled_from(['{"linear": %s, "angular": 0}', '{"epoch": %s, "linear": 0, "angular": 0}', '[%s]']),
+    st.tuples(st.sampled_from(['{"linear": %s, "angular": 0}', '{"epoch": %s, "linear": 0, "angular": 0}', '[%s]',
+                               '{"linear": 0, "angular": 0, "seq": %s}', '{"linear": 0, "angular": 0, "t": %s}']),
               st.sampled_from(["NaN", "-Infinity", "1e400", "-1e999", "1" + "0" * 400, "0.1e-400", "01", "1.", "-",
                                '"\\ud800"', "1E+2", "-0", "true", "null"])).map(lambda t: t[0] % t[1]),
     st.text(max_size=30),

@@ -9,7 +9,8 @@ import threading
 
 import pytest
 
-from rover_web.teleop.control import Limits, TeleopController
+from rover_web.teleop.commands import Limits
+from rover_web.teleop.control import TeleopController
 from rover_web.teleop.websocket import CLOSE_INTERNAL_ERROR, CLOSE_POLICY_VIOLATION, FrameReader, TeleopSocket
 from rover_web.teleop.ws_frames import OP_CLOSE, OP_PING, OP_PONG, OP_TEXT
 from tests.support import ws_wire
@@ -92,8 +93,8 @@ def rig():
     session = controller.connect("alice")
     teleop = TeleopSocket(ws, controller, session, max_frame_bytes=4096)
     stopping = threading.Event()
-    serve = threading.Thread(target=teleop.serve, args=({"type": "hello"}, stopping), kwargs={"ping_s": None},
-                             daemon=True)
+    serve = threading.Thread(target=teleop.serve, args=({"type": "hello"}, stopping),
+                             kwargs={"ping_s": None, "link_s": None}, daemon=True)
     yield out, controller, ws, Browser(browser_end), stopping, serve
     stopping.set()
     session.wake()  # a test may have stretched the request thread's poll
@@ -144,6 +145,45 @@ def test_an_error_frame_answers_a_bad_value_and_the_socket_stays_open(rig):
     browser.send({"linear": 0.1, "angular": 0.0})
     browser.wait_for(lambda m: m.get("in_control") is True)
     assert out.sent == [(0.5, 0.0)]
+
+
+def test_seq_and_t_reach_the_controller_and_a_late_or_malformed_one_gets_an_error_frame(rig):
+    out, controller, ws, browser, stopping, serve = rig
+    start(serve, browser)
+    browser.send({"linear": 0.2, "angular": 0.0, "seq": 5, "t": 1000.5})
+    browser.wait_for(lambda m: m.get("in_control") is True)
+    browser.send({"linear": 0.6, "angular": 0.0, "seq": 4, "t": 990.0})
+    assert browser.next()["error"] == "stale_seq"
+    for bad in ({"seq": -1}, {"seq": 1.5}, {"seq": None}, {"seq": "6"}, {"t": "now"}, {"t": -1}, {"t": None}):
+        browser.send({"linear": 0.6, "angular": 0.0, **bad})
+        assert browser.next()["error"] in ("bad_type", "out_of_range"), bad
+    assert out.sent == [(1.0, 0.0)] + [(0.0, 0.0)]  # the first bad frame stopped it; nothing else moved
+
+
+def test_a_socket_gets_measuring_pings_and_periodic_state_frames_with_its_link():
+    out = Output()
+    controller = TeleopController(out, Limits(5.0, 2.0), rate_hz=40, deadman_s=0.3)
+    server_end, browser_end = socket.socketpair()
+    ws = Connection(server_end)
+    teleop = TeleopSocket(ws, controller, controller.connect("alice"), max_frame_bytes=4096)
+    stopping = threading.Event()
+    serve = threading.Thread(target=teleop.serve, args=({"type": "hello"}, stopping),
+                             kwargs={"ping_s": None, "link_s": 0.05}, daemon=True)
+    serve.start()
+    browser = Browser(browser_end)
+    try:
+        ping = browser.next(OP_PING)
+        assert len(ping) == 4  # an id, answered like any browser does: the same payload back
+        browser.sock.sendall(ws_wire.masked(0x8A, ping))
+        state = browser.wait_for(lambda m: m.get("reason") == "link" and m["link"]["rtt_ms"] is not None)
+        assert state["type"] == "state" and state["link"]["quality"] == "ok" and state["link"]["rtt_ms"] >= 0
+        assert {"jitter_ms", "stalls", "last_stall_ms"} <= set(state["link"])
+    finally:
+        stopping.set()
+        serve.join(5)
+        server_end.close()
+        browser_end.close()
+    assert not serve.is_alive()
 
 
 def test_pings_are_answered_with_their_payload_by_the_reader(rig):
@@ -236,7 +276,7 @@ def test_a_client_that_misses_a_ping_loses_the_socket_and_control():
     server_end, browser_end = socket.socketpair()
     ws = Connection(server_end)
     teleop = TeleopSocket(ws, controller, controller.connect("mute"), max_frame_bytes=4096)
-    serve = threading.Thread(target=teleop.serve, args=({"type": "hello"}, threading.Event(), 0.1), daemon=True)
+    serve = threading.Thread(target=teleop.serve, args=({"type": "hello"}, threading.Event(), 0.1, None), daemon=True)
     serve.start()
     browser = Browser(browser_end)
     browser.next()
