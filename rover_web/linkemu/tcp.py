@@ -63,10 +63,12 @@ class _Connection:
     def close(self) -> None:
         for writer in self.writers:
             writer.close()
+        self.relay.connections.discard(self)
 
     def abort(self) -> None:
         for writer in self.writers:
             writer.transport.abort()
+        self.relay.connections.discard(self)
 
 
 class TcpRelay:
@@ -99,6 +101,10 @@ class TcpRelay:
         await asyncio.gather(*self._tasks, return_exceptions=True)
         if self._server is not None:
             await self._server.wait_closed()
+        # An aborted transport closes its socket in a callback on the next turns of the loop: give
+        # them those turns, or the loop closes first and the sockets are left to the collector.
+        for _ in range(3):
+            await asyncio.sleep(0)
 
     def reset_all(self) -> None:
         """An outage that resets connections: both ends see them close at once."""
@@ -109,6 +115,7 @@ class TcpRelay:
         task = asyncio.current_task()
         self._tasks.add(task)
         self.accepted += 1
+        sock = server_w = None
         try:
             _small_buffers(client_w.get_extra_info("socket"))
             sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
@@ -129,8 +136,16 @@ class TcpRelay:
                 await asyncio.gather(self._pump(client_r, server_w, self.up, conn.up),
                                      self._pump(server_r, client_w, self.down, conn.down))
             finally:
-                self.connections.discard(conn)
+                # Both ends read to their end, but the last bytes and the EOFs may still be in the
+                # link: the connection stays listed (stop() can abort it) until _deliver closes it.
+                if all(w.is_closing() for w in conn.writers):
+                    self.connections.discard(conn)
         except asyncio.CancelledError:
+            client_w.transport.abort()  # cancelled at any point: both ends of it go
+            if server_w is not None:
+                server_w.transport.abort()
+            elif sock is not None:
+                sock.close()
             # stop(): end quietly. Python 3.11's start_server asks a finished handler task for its
             # exception, which raises (and is logged) for a cancelled one.
             return
