@@ -273,6 +273,9 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("PLOT_MAX_MESSAGE_BYTES", 65536, "int",
             "plotted topics' messages larger than this are dropped unread (images and point clouds are refused)",
             1024, 16 * 1024 * 1024),
+    Setting("PLOT_SERIES_PER_CLIENT", 16, "int",
+            "most series one user (or, with sign-in off, one non-loopback address) keeps plotted at once "
+            "(503 beyond), so no client takes every series of the 64", 1, 64),
     Setting("PLOT_IDLE_S", 30.0, "float",
             "a plotted series ends this long after a page last asked for it",
             1.0, 3600),

@@ -11,7 +11,7 @@ from rover_web.core.state import current_feature
 from rover_web.topics.routes import STATUS as ECHO_STATUS
 from rover_web.topics.service import EchoRefused, TopicBrowser
 from rover_web.web.http import ApiError
-from rover_web.web.streams import refuse_cross_site
+from rover_web.web.streams import client_key, refuse_cross_site
 from rover_web.web.validate import InvalidInput
 
 from . import msgs
@@ -62,7 +62,7 @@ def api_plot():
     key = _topic_key(args)
     plots = current_feature(Plots)
     try:
-        series = plots.series(key, field)
+        series = plots.series(key, field, client_key())
     except NotPlottable as exc:
         raise ApiError(422, "not_plottable", str(exc)) from None
     except FieldError as exc:

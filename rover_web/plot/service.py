@@ -9,6 +9,7 @@ by the plot loop, which also sends the new points of every series as one `plot` 
 from __future__ import annotations
 
 import logging
+import math
 import threading
 import time
 from collections import deque
@@ -50,6 +51,9 @@ class _Series:
         self.steps = parse_path(field)
         self.ring = SeriesRing(keep)
         self.used_at = time.monotonic()
+        # Who asked for it lately (client key → when): a series counts against the share of each
+        # client that polls it, and no longer once that client has not asked for PLOT_IDLE_S.
+        self.users: dict[str, float] = {}
 
 
 class _PlotTopic:
@@ -106,6 +110,7 @@ class Plots:
         self.keep = rover.config["ROVER_WEB_PLOT_KEEP_POINTS"]
         self.idle_s = rover.config["ROVER_WEB_PLOT_IDLE_S"]
         self.max_message_bytes = rover.config["ROVER_WEB_PLOT_MAX_MESSAGE_BYTES"]
+        self.per_client = rover.config["ROVER_WEB_PLOT_SERIES_PER_CLIENT"]
         self._topics: dict[tuple[str, str], _PlotTopic] = {}
         self._lock = threading.Lock()
         self.decode_errors = 0
@@ -115,20 +120,30 @@ class Plots:
     def browser(self) -> TopicBrowser:
         return self.rover.feature(TopicBrowser)
 
-    def series(self, key: tuple[str, str], field: str) -> _Series:
-        """The series of `field` on topic `key` (topic, type), started now if new.
+    def series(self, key: tuple[str, str], field: str, client: str | None = None) -> _Series:
+        """The series of `field` on topic `key` (topic, type), started now if new, for `client`
+        (web/streams.py's client_key: a user or an address; None counts against no share).
 
-        NotPlottable for a type of bulk data; FieldError when the type has no number there; the
-        topic browser's EchoRefused when its subscription cannot be had (caps, shutdown).
+        NotPlottable for a type of bulk data; FieldError when the type has no number there;
+        TooManySeries when all series, or this client's share of them, are taken; the topic
+        browser's EchoRefused when its subscription cannot be had (caps, shutdown).
         """
         check_plottable(key[1])
         steps = parse_path(field)
         msgs.numeric_kind(key[1], steps)
+        now = time.monotonic()
         with self._lock:
             plot_topic = self._topics.get(key)
-            if plot_topic is not None and field in plot_topic.series:
-                series = plot_topic.series[field]
-                series.used_at = time.monotonic()
+            series = plot_topic.series.get(field) if plot_topic is not None else None
+            if client is not None and (series is None or client not in series.users):
+                held = self._held_by(client, now)
+                if held >= self.per_client:
+                    raise TooManySeries(f"you plot {held} series already (ROVER_WEB_PLOT_SERIES_PER_CLIENT): "
+                                        f"close one, or wait {self.idle_s:g} s after you stop asking for it")
+            if series is not None:
+                series.used_at = now
+                if client is not None:
+                    series.users[client] = now
                 return series
             if sum(len(p.series) for p in self._topics.values()) >= MAX_SERIES:
                 raise TooManySeries(f"{MAX_SERIES} series are plotted already")
@@ -137,8 +152,15 @@ class Plots:
                 plot_topic = self._topics[key] = _PlotTopic(key, echo, self.max_message_bytes)
                 echo.listeners = (*echo.listeners, plot_topic.put)
             series = plot_topic.series[field] = _Series(field, self.keep)
+            if client is not None:
+                series.users[client] = now
             self.plotting.set()
             return series
+
+    def _held_by(self, client: str, now: float) -> int:
+        """How many series `client` asked for within the idle time (the lock held)."""
+        return sum(1 for p in self._topics.values() for s in p.series.values()
+                   if now - s.users.get(client, -math.inf) <= self.idle_s)
 
     def tick(self) -> None:
         """Decode what arrived, append to the rings, send the new points, end idle series."""

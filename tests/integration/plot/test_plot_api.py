@@ -147,3 +147,32 @@ def test_messages_over_the_size_cap_are_dropped_unread(live_server_factory, ros_
     assert reply["v"] == [7.0]
     wait_until(lambda: plot(server, topic="/test/array", field="data[0]").json()["skipped_oversize"] == 3, 10,
                "three big messages dropped")
+
+
+def test_one_user_cannot_take_every_series(live_server_factory, ros_peer, tmp_path):
+    """Issue 27: a client holds at most ROVER_WEB_PLOT_SERIES_PER_CLIENT series; others still plot,
+    and a series the client stopped asking for leaves its share after PLOT_IDLE_S."""
+    from tests.conftest import _signed_settings
+
+    settings, tokens = _signed_settings(tmp_path)
+    server = live_server_factory(**settings, ROVER_WEB_PLOT_SERIES_PER_CLIENT=2, ROVER_WEB_PLOT_IDLE_S=1.0)
+    peer = ros_peer("odom_peer")
+    peer.advertise("/test/odom", ODOM)
+    viewer = {"Authorization": f"Bearer {tokens['viewer']}"}
+    operator = {"Authorization": f"Bearer {tokens['operator']}"}
+    wait_until(lambda: any(t["name"] == "/test/odom" for t in requests.get(
+        server.url + "/api/topics", headers=viewer, timeout=5).json()["topics"]), 15, "topic listed")
+
+    def ask(headers, field):
+        return requests.get(server.url + "/api/plot", params={"topic": "/test/odom", "field": field},
+                            headers=headers, timeout=5)
+
+    fields = ["pose.pose.position.x", "pose.pose.position.y", "pose.pose.position.z"]
+    assert ask(viewer, fields[0]).status_code == 200 and ask(viewer, fields[1]).status_code == 200
+    assert ask(viewer, fields[0]).status_code == 200  # asking again for one it has costs nothing
+    third = ask(viewer, fields[2])
+    assert third.status_code == 503 and third.json()["error"] == "too_many_series", third.text
+    assert ask(operator, fields[2]).status_code == 200  # someone else still plots
+    assert ask(operator, fields[0]).status_code == 200  # and shares the viewer's series
+    # The viewer stops asking for its first two: after the idle time they are no longer its share.
+    wait_until(lambda: ask(viewer, fields[2]).status_code == 200, 10, "the viewer's share freed")
