@@ -124,6 +124,8 @@ def _view_accepts_form() -> bool:
 # goes to this host over https only for a year, so a sign-in is never sent in clear by a typed
 # http:// address. No includeSubDomains: a robot's name says nothing about its neighbours'.
 HSTS = "max-age=31536000"
+
+
 def accepts_media(*types: str):
     """Mark a view whose body has a media type of its own besides JSON (WHEP's application/sdp)."""
     def mark(view):
