@@ -27,6 +27,12 @@ from collections import deque
 from .hub import EventHub, Subscription
 
 _IDLE_CHECK_S = 1.0
+# Each stream's kernel send buffer, fixed (the kernel doubles it for its own bookkeeping). Left to
+# autotuning it grows to megabytes behind a slow or congested link, and the "full socket, skip to
+# the newest value" rule below only starts once megabytes of old events wait in it: through a
+# 2 Mbit/s link an odometry value was 3 s old at the median, 14 s at worst (bench/link.py). Event
+# streams are a few kB/s; this holds a few seconds of them and lets a slow link skip the rest.
+SEND_BUFFER_BYTES = 32 * 1024
 
 
 class _Client:
@@ -84,6 +90,10 @@ class Broadcaster:
     def attach(self, sock: socket.socket, sub: Subscription) -> _Client:
         """Serve `sock` from now on; the returned stream's wait() returns once it has ended."""
         client = _Client(sock, sub)
+        try:
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, SEND_BUFFER_BYTES)
+        except OSError:
+            pass  # a socket that is already gone: the thread finds it dead
         with self._lock:
             if self._hub.closed:
                 client.done.set()
