@@ -1,7 +1,7 @@
 """rover_web over an emulated field link: teleop, e-stop, video and events through the link emulator.
 
-    .venv/bin/python bench/link.py --profile wifi-edge --camera on [--video mjpeg] [--adapt on|off]
-                                   [--seconds 60] [--estops 10] [--seed 1]
+    .venv/bin/python bench/link.py --profile wifi-edge --camera on [--video mjpeg|webrtc] [--adapt on|off]
+                                   [--teleop websocket|datachannel] [--seconds 60] [--estops 10] [--seed 1]
 
 Starts the demo's simulator (`python -m rover_web.sim`: rover, buoy, drone, camera 640×480 at
 30 Hz) and the app (`flask run`, bench/common.Server) in their own processes, and a LinkEmulator
@@ -25,6 +25,10 @@ the emulator only; the rclpy subscriber watching /cmd_vel is on the robot's side
 2. E-stop phase (`--estops` times, for at most 120 s; the stick released, camera and events still
    flowing): POST /api/estop {"engaged": true} timed to its answer (estop_rtt_*), then a timed
    release. A POST unanswered after 30 s counts as 30 s and is counted (estop_timeouts).
+--video webrtc: the viewer is an aiortc WHEP client (bench/link_webrtc.py) whose media and data
+channel cross the emulator's UDP path (SDP candidates rewritten; `webrtc_route` in the JSON names
+the pair it used); frames are decoded and their time code read the same way. --teleop datachannel
+holds the stick over that session's `teleop` data channel instead of the WebSocket.
 link_rtt_ms is the profile's nominal round trip (2 × one-way delay); link_rtt_measured_ms is the
 median of 10 GET /api/estop on the idle link before the hold phase (a small request and answer).
 """
