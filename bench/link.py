@@ -1,7 +1,7 @@
 """rover_web over an emulated field link: teleop, e-stop, video and events through the link emulator.
 
-    .venv/bin/python bench/link.py --profile wifi-edge --camera on [--video mjpeg] [--adapt on|off]
-                                   [--seconds 60] [--estops 10] [--seed 1]
+    .venv/bin/python bench/link.py --profile wifi-edge --camera on [--video mjpeg|webrtc] [--adapt on|off]
+                                   [--teleop websocket|datachannel] [--seconds 60] [--estops 10] [--seed 1]
 
 Starts the demo's simulator (`python -m rover_web.sim`: rover, buoy, drone, camera 640×480 at
 30 Hz) and the app (`flask run`, bench/common.Server) in their own processes, and a LinkEmulator
@@ -25,6 +25,10 @@ the emulator only; the rclpy subscriber watching /cmd_vel is on the robot's side
 2. E-stop phase (`--estops` times, for at most 120 s; the stick released, camera and events still
    flowing): POST /api/estop {"engaged": true} timed to its answer (estop_rtt_*), then a timed
    release. A POST unanswered after 30 s counts as 30 s and is counted (estop_timeouts).
+--video webrtc: the viewer is an aiortc WHEP client (bench/link_webrtc.py) whose media and data
+channel cross the emulator's UDP path (SDP candidates rewritten; `webrtc_route` in the JSON names
+the pair it used); frames are decoded and their time code read the same way. --teleop datachannel
+holds the stick over that session's `teleop` data channel instead of the WebSocket.
 link_rtt_ms is the profile's nominal round trip (2 × one-way delay); link_rtt_measured_ms is the
 median of 10 GET /api/estop on the idle link before the hold phase (a small request and answer).
 """
@@ -47,7 +51,8 @@ import requests
 from common import ROOT, WALL_MINUS_MONOTONIC, Server, SseFleet, machine, percentile, ros_env
 
 sys.path.insert(0, str(ROOT))
-from teleop import Subscriber, connect, encoded, frame, hang_up  # noqa: E402
+from link_webrtc import ChannelSocket, LinkWhep  # noqa: E402
+from teleop import Heard, Subscriber, connect, encoded, frame, hang_up  # noqa: E402
 
 from rover_web import config as config_module  # noqa: E402
 from rover_web.linkemu import PROFILES, LinkEmulator, profile  # noqa: E402
@@ -74,9 +79,10 @@ class Stick(threading.Thread):
     """The operator's thumb on the stick: a frame every 1/STICK_HZ s, each a new value, with the
     epoch the server last said (a deadman stop starts a new one)."""
 
-    def __init__(self, ws):
+    def __init__(self, ws, send=None):
         super().__init__(daemon=True)
-        self.ws = ws
+        self.ws = ws  # bench/teleop.connect's WebSocket, or link_webrtc.ChannelSocket: .heard, .send(text)
+        self._send = send or (lambda text: ws.sock.sendall(encoded(text)))  # pre-encoded frame: no masking cost
         self.sent: list[tuple[float, int]] = []  # (monotonic, value index)
         self.lost_at: float | None = None  # when the socket failed under the stick, if it did
         self.running = threading.Event()
@@ -87,10 +93,10 @@ class Stick(threading.Thread):
         while self.running.is_set():
             while (wait := start + i * period - time.monotonic()) > 0:
                 time.sleep(wait)
-            data = encoded(frame(stick_value(i), epoch=self.ws.heard.epoch))
+            text = frame(stick_value(i), epoch=self.ws.heard.epoch)
             t = time.monotonic()
             try:
-                self.ws.sock.sendall(data)
+                self._send(text)
             except OSError:
                 self.lost_at = time.monotonic()  # the server closed it: reported, not retried
                 return
@@ -102,7 +108,7 @@ class Stick(threading.Thread):
         self.join(5)
         if self.lost_at is None:
             try:
-                self.ws.send(json.dumps({"stop": True}))
+                self._send(json.dumps({"stop": True}))
             except OSError:
                 self.lost_at = time.monotonic()
 
@@ -277,32 +283,51 @@ def run(args) -> dict:
     load_before = os.getloadavg()[0]
     scratch = tempfile.TemporaryDirectory(prefix="rover_web-bench-link-")
     extra, adapt = adapt_setting(args.adapt)
+    webrtc = args.video == "webrtc" and args.camera == "on"
+    if webrtc:
+        extra["ROVER_WEB_WEBRTC_HOST_ADDRESSES"] = "127.0.0.1"  # the answer's one candidate (link_webrtc.py)
     env = ros_env(ROVER_WEB_DB_PATH=os.path.join(scratch.name, "bench.sqlite3"), **extra)
-    print(f"# link bench on {machine()}: {link.describe()}; camera {args.camera}, adapt {adapt}; "
+    print(f"# link bench on {machine()}: {link.describe()}; camera {args.camera} ({args.video}), adapt {adapt}, "
+          f"teleop over {args.teleop}; "
           f"ROS domain {env['ROS_DOMAIN_ID']}", flush=True)
     sim = subprocess.Popen([sys.executable, "-m", "rover_web.sim"], cwd=ROOT, env=env,
                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    server = sub = emu = ws = viewer = events = None
+    server = sub = emu = ws = viewer = events = server_said_video = None
     try:
         server = Server(env)
         sub = Subscriber(env)
-        emu = LinkEmulator(link, "127.0.0.1:0", ("127.0.0.1", server.port), seed=args.seed).start()
+        # The UDP relay's target is the server's ICE port, known only from the WHEP answer: LinkWhep
+        # sets it before the first datagram (port 9, discard, until then).
+        udp = {"udp_listen": "127.0.0.1:0", "udp_target": ("127.0.0.1", 9)} if webrtc else {}
+        emu = LinkEmulator(link, "127.0.0.1:0", ("127.0.0.1", server.port), seed=args.seed, **udp).start()
         url = f"http://127.0.0.1:{emu.port}"
         measured_rtt = link_rtt(url)
         events = Events(url)
         events.start()
         wait_for(lambda: events.ages, 60, "the first odom event through the link")
-        ws = connect(url)  # before the video: its handshake would otherwise queue behind seconds of frames
-        if args.camera == "on":
+        if args.teleop == "websocket":
+            ws = connect(url)  # before the video: its handshake would otherwise queue behind seconds of frames
+        if webrtc:
+            viewer = LinkWhep(emu, url, TOPIC, teleop=args.teleop == "datachannel")
+        elif args.camera == "on":
             viewer = Viewer(url)
+        if viewer is not None:
             wait_for(lambda: viewer.samples, 60, "the first camera frame through the link")
-        stick = Stick(ws)
+        if args.teleop == "datachannel":
+            ws = ChannelSocket(viewer, Heard)
+            stick = Stick(ws, send=ws.send)
+        else:
+            stick = Stick(ws)
         mark = sub.mark()
         stick.start()
         time.sleep(2.0)  # settle: the first frames, the video's queue filling
         t_start = time.monotonic()
         time.sleep(args.seconds)
         t_end = time.monotonic()
+        if webrtc:  # what the server's adaptation chose by the end of the hold (asked on loopback, not the link)
+            session = requests.get(server.url + "/api/camera/whep", timeout=10).json()["sessions"]
+            server_said_video = {k: session[0].get(k) for k in ("level", "width", "height", "fps", "target_bps",
+                                                               "remb_bps")} if session else None
         stick.release()
         twists = sub.since(mark)
         said = dict(ws.heard.counts)
@@ -311,11 +336,13 @@ def run(args) -> dict:
         t_estop_end = time.monotonic()
         windows = emu.windows()
         counters = emu.counters()
+        route = viewer.route() if webrtc else None
+        sizes = viewer.size_shares(t_start, t_end) if webrtc else None
     finally:
         for part in (viewer, events):
             if part is not None:
                 part.close()
-        if ws is not None:
+        if ws is not None and args.teleop == "websocket":
             hang_up(ws)
         if emu is not None:
             emu.stop()
@@ -337,6 +364,8 @@ def run(args) -> dict:
     stops_out, stops_in = spurious_stops(twists, t_start, t_end, outages)
     frames = viewer.window(t_start, t_end) if viewer else []
     ages = [age for _, age, _ in frames if age is not None]
+    ages_outside = [age for t, age, _ in frames  # issue 26's radio target is "outside outages"
+                    if age is not None and not any(a <= t <= b + OUTAGE_GRACE_S for a, b in outages)]
     estop_frames = viewer.window(t_estop, t_estop_end) if viewer else []
     event_ages = [age for t, age in events.ages if t_start <= t <= t_end]
     result = {
@@ -344,6 +373,7 @@ def run(args) -> dict:
         "camera": args.camera,
         "video": args.video,
         "adapt": adapt,
+        "teleop": args.teleop,
         "seconds": round(held_s, 1),
         "link_rtt_ms": link.rtt_ms,
         "link_rtt_measured_ms": round(measured_rtt, 1),
@@ -360,10 +390,12 @@ def run(args) -> dict:
         "estop_rtt_p99_ms": ms(engage, 99),
         "estop_release_p99_ms": ms(release, 99),
         "video_fps": round(len(frames) / held_s, 2),
-        "video_kbps": round(sum(b for _, _, b in frames) * 8 / held_s / 1000, 1),
+        "video_kbps": round(  # MJPEG: JPEG bytes; WebRTC: RTP payload bytes
+sum(b for _, _, b in frames) * 8 / held_s / 1000, 1),
         "frames_unreadable": sum(1 for _, age, _ in frames if age is None),
         "frame_age_p50_ms": ms(ages, 50),
         "frame_age_p99_ms": ms(ages, 99),
+        "frame_age_p99_outside_outages_ms": ms(ages_outside, 99),  # frames arriving in an outage or 1 s after left out
         "video_fps_during_estops": round(len(estop_frames) / max(1e-9, t_estop_end - t_estop), 2),
         "event_age_p50_ms": ms(event_ages, 50),
         "event_age_p99_ms": ms(event_ages, 99),
@@ -372,6 +404,13 @@ def run(args) -> dict:
         "outages": counters["outages"],
         "down_queue_peak_kb": round(counters["down"]["queue_peak"] / 1000, 1),
         "seed": emu.seed,
+        # WebRTC: the client's nominated ICE pairs (the remote must be the emulator's UDP port) and
+        # the UDP bytes that crossed the emulator towards the client (counters are per direction, TCP + UDP).
+        "webrtc_route": route,
+        "webrtc_sizes": sizes,  # decoded frame sizes in the hold, with their share of frames
+        "webrtc_server": server_said_video if webrtc else None,
+        "emulator_udp_port": emu.udp_port if webrtc else None,
+        "server_ice_port": viewer.server_port if webrtc else None,
         "load_avg": [round(load_before, 1), round(os.getloadavg()[0], 1)],  # the machine's, start and end
     }
     return result
@@ -384,7 +423,8 @@ def table(r: dict) -> str:
         ("link", f"{r['profile']}: nominal RTT {r['link_rtt_ms']:g} ms, measured {r['link_rtt_measured_ms']} ms; "
                  f"{r['stalls']} stalls, {r['outages']} outages in the run; downlink queue peak "
                  f"{r['down_queue_peak_kb']} kB; load average {r['load_avg'][0]} → {r['load_avg'][1]}"),
-        ("teleop frame → /cmd_vel", f"p50 {f(r['teleop_p50_ms'], ' ms')}, p99 {f(r['teleop_p99_ms'], ' ms')} "
+        (f"teleop ({r['teleop']}) frame → /cmd_vel", f"p50 {f(r['teleop_p50_ms'], ' ms')}, "
+                                                     f"p99 {f(r['teleop_p99_ms'], ' ms')} "
                                     f"({r['teleop_frames_matched']} frames matched)"),
         ("spurious stops", f"{r['spurious_stops_per_min']} per minute held ({r['stops_in_outages']} more "
                            f"during outages); server said {r['server_said'] or 'nothing'}"
@@ -394,8 +434,10 @@ def table(r: dict) -> str:
                                    f"release p99 {f(r['estop_release_p99_ms'], ' ms')} ({r['estop_trials']} trials"
                                    + (f", {r['estop_timeouts']} POSTs unanswered after {ESTOP_TIMEOUT_S:g} s"
                                       if r["estop_timeouts"] else "") + ")"),
-        ("video", f"{r['video_fps']} fps, {r['video_kbps']} kbit/s, frame age p50 {f(r['frame_age_p50_ms'], ' ms')}"
-                  f", p99 {f(r['frame_age_p99_ms'], ' ms')} ({r['frames_unreadable']} unreadable)"),
+        ("video", f"{r['video']}: {r['video_fps']} fps, {r['video_kbps']} kbit/s, "
+                  f"frame age p50 {f(r['frame_age_p50_ms'], ' ms')}"
+                  f", p99 {f(r['frame_age_p99_ms'], ' ms')} (outside outages "
+                  f"{f(r['frame_age_p99_outside_outages_ms'], ' ms')}; {r['frames_unreadable']} unreadable)"),
         ("odom events", f"{r['events_per_s']} /s, age p50 {f(r['event_age_p50_ms'], ' ms')}, "
                         f"p99 {f(r['event_age_p99_ms'], ' ms')}"),
     ]
@@ -409,16 +451,17 @@ def main() -> int:
                         help="the link; loopback: the emulator with no limits, a control for the machine's own noise")
     parser.add_argument("--camera", choices=("on", "off"), default="on")
     parser.add_argument("--video", choices=("mjpeg", "webrtc"), default="mjpeg")
+    parser.add_argument("--teleop", choices=("websocket", "datachannel"), default="websocket",
+                        help="drive over WS /ws/teleop, or over the WHEP session's `teleop` data channel "
+                             "(needs --video webrtc --camera on)")
     parser.add_argument("--adapt", choices=("on", "off"), default=None,
                         help="sets ROVER_WEB_CAMERA_ADAPT on the app (default: the app's default)")
     parser.add_argument("--seconds", type=float, default=60.0, help="how long the stick is held")
     parser.add_argument("--estops", type=int, default=10, help="e-stop engage/release trials after the hold")
     parser.add_argument("--seed", type=int, default=1, help="the emulator's random seed (stalls, jitter)")
     args = parser.parse_args()
-    if args.video == "webrtc":
-        print("bench/link.py: --video webrtc is not available yet (the WebRTC path is issue 25's next part)",
-              file=sys.stderr)
-        return 2
+    if args.teleop == "datachannel" and (args.video != "webrtc" or args.camera != "on"):
+        parser.error("--teleop datachannel needs --video webrtc --camera on (the channel is the WHEP session's)")
     result = run(args)
     print(table(result), flush=True)
     print(json.dumps(result), flush=True)
