@@ -138,7 +138,7 @@ def test_an_operator_sees_the_fence_editor_disabled_with_the_reason(live_server_
     assert page.watch.offhost == []
 
 
-def test_an_admin_edits_and_saves_and_a_lowered_role_meets_the_servers_403(live_server_factory, page, tmp_path):
+def test_an_admin_edits_and_saves_and_a_lowered_role_meets_the_servers_refusal(live_server_factory, page, tmp_path):
     server = signed_map_server(live_server_factory, tmp_path)
     sign_in(page, server.url, "admin")
     open_map(page, server.url)
@@ -168,7 +168,9 @@ def test_an_admin_edits_and_saves_and_a_lowered_role_meets_the_servers_403(live_
     page.locator("#gf-save").click()
     page.wait_for_selector("#gf-message[data-kind='error']")
     shown = page.locator("#gf-message").inner_text()
-    assert shown.startswith("Fence not saved: ") and "admin" in shown
+    # A role change ends the user's sessions (docs/security.md): the server's refusal is a 401
+    # asking to sign in again, shown in its own words.
+    assert shown.startswith("Fence not saved: ") and "sign in" in shown
     assert fence(server.url, server.tokens["viewer"])["revision"] == 1
     assert page.watch.offhost == []
 
