@@ -173,6 +173,8 @@ def test_ring_events_reach_every_tab_once_across_a_hand_over_and_not_a_tab_that_
 
 def test_estop_reaches_the_server_within_a_second_with_eight_tabs_open(live_server, sim_process, context):
     sim_process()  # every dashboard shows the simulated camera
+    # Over MJPEG, the stream that shares the tabs' HTTP/1.1 connections with the e-stop's POST.
+    context.add_init_script("localStorage.setItem('rover_web.camera.transport', 'mjpeg')")
     pages = open_tabs(context, live_server.url + "/", one_window=True)
     camera = lambda: requests.get(live_server.url + "/api/camera/streams", timeout=5).json()["viewers"]  # noqa: E731
     wait_until(lambda: camera() == 1, 15, "one camera stream, the visible tab's")
