@@ -167,6 +167,10 @@ class TcpRelay:
                 direction.push(flow, data)  # b"" at the end of the stream: delivered in order as EOF
                 if not data:
                     return
+                # Let the other connections' pumps in: with its reader's buffer full, this loop
+                # would otherwise take all the room the link freed without ever yielding, and one
+                # connection would have the link while the others waited (a real queue interleaves).
+                await asyncio.sleep(0)
         except (ConnectionError, OSError):
             # A reset: the other side learns at once (a real link would carry the RST too).
             dest.transport.abort()

@@ -2,6 +2,7 @@
 
 import io
 import math
+import re
 import time
 from urllib.parse import quote
 
@@ -193,4 +194,9 @@ def test_the_dashboard_renders_the_robot_dot_with_the_page(app):
     service = app.extensions[EXTENSION].feature(LiveMapService)
     service.on_pose((18.0, 10.5, 0.0, "map", 1.0))   # as the /amcl_pose callback would
     html = app.test_client().get("/").data.decode()
-    assert 'style="left: 50.0%; top: 50.0%"' in html and "18.0, 10.5 m" in html
+    # The dot's place is data the page's script turns into a position (no inline style: the CSP).
+    width = float(re.search(r'id="livemap-thumb"[^>]*data-width="([\d.]+)"', html).group(1))
+    height = float(re.search(r'id="livemap-thumb"[^>]*data-height="([\d.]+)"', html).group(1))
+    x = float(re.search(r'id="livemap-thumb-robot"[^>]*data-x="([-\d.]+)"', html).group(1))
+    y = float(re.search(r'id="livemap-thumb-robot"[^>]*data-y="([-\d.]+)"', html).group(1))
+    assert (x / width, y / height) == (0.5, 0.5) and "18.0, 10.5 m" in html
