@@ -22,6 +22,7 @@ from __future__ import annotations
 import io
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -180,19 +181,19 @@ def is_jpeg(data) -> bool:
 IMAGE_FORMATS = ("JPEG", "PNG")
 
 
-def encode_compressed(frame: CompressedFrame, quality: int, width: int | None = None,
-                      height: int | None = None, max_pixels: int | None = None) -> Jpeg:
-    """A sensor_msgs/CompressedImage as JPEG: passed through if it is one and no size is asked."""
-    started = time.perf_counter()
+def check_compressed_format(frame: CompressedFrame) -> None:
     if "compresseddepth" in frame.format.lower():
         raise FrameError("compressedDepth images are not supported; view the raw depth topic instead",
                          "unsupported_encoding")
-    data = bytes(frame.data)
-    if is_jpeg(data):
-        size = _jpeg_size(data)
-        if size != (0, 0) and output_size(size[0], size[1], width, height, max_pixels) == size:
-            return Jpeg(data, size[0], size[1], frame.stamp, passthrough=True,
-                        encode_s=time.perf_counter() - started)
+
+
+def decode_compressed(frame: CompressedFrame, data: bytes | None = None,
+                      output_size_of: Callable[[int, int], tuple[int, int]] | None = None) -> Image.Image:
+    """A CompressedImage's picture, RGB or L (16-bit and float stretched to 8 bits): FrameError for
+    what cannot be shown. `output_size_of(w, h)` lets libjpeg scale by 1/2, 1/4 or 1/8 while
+    decoding when the output will be smaller."""
+    check_compressed_format(frame)
+    data = bytes(frame.data) if data is None else data
     try:
         # Only the two formats a camera sends: Pillow would otherwise also parse EPS (through
         # Ghostscript), TIFF, ICO and dozens more from bytes any publisher on the graph chooses.
@@ -200,9 +201,8 @@ def encode_compressed(frame: CompressedFrame, quality: int, width: int | None = 
         if picture.width * picture.height > MAX_PIXELS:
             raise FrameError(f"image is {picture.width}×{picture.height}, more than {MAX_PIXELS} pixels",
                              "image_too_large")
-        if picture.format == "JPEG":
-            # Let libjpeg scale by 1/2, 1/4 or 1/8 while decoding when the output is smaller.
-            picture.draft("RGB", output_size(picture.width, picture.height, width, height, max_pixels))
+        if picture.format == "JPEG" and output_size_of is not None:
+            picture.draft("RGB", output_size_of(picture.width, picture.height))
         picture.load()
     except FrameError:
         raise
@@ -211,9 +211,24 @@ def encode_compressed(frame: CompressedFrame, quality: int, width: int | None = 
     if picture.mode in ("I;16", "I;16B", "I;16L", "I", "F"):
         values = np.asarray(picture)
         valid = np.isfinite(values) & (values != 0) if values.dtype.kind == "f" else values > 0
-        picture = Image.fromarray(stretch_to_8bit(values, valid))
-    elif picture.mode not in ("RGB", "L"):
-        picture = picture.convert("RGB")
+        return Image.fromarray(stretch_to_8bit(values, valid))
+    if picture.mode not in ("RGB", "L"):
+        return picture.convert("RGB")
+    return picture
+
+
+def encode_compressed(frame: CompressedFrame, quality: int, width: int | None = None,
+                      height: int | None = None, max_pixels: int | None = None) -> Jpeg:
+    """A sensor_msgs/CompressedImage as JPEG: passed through if it is one and no size is asked."""
+    started = time.perf_counter()
+    check_compressed_format(frame)
+    data = bytes(frame.data)
+    if is_jpeg(data):
+        size = _jpeg_size(data)
+        if size != (0, 0) and output_size(size[0], size[1], width, height, max_pixels) == size:
+            return Jpeg(data, size[0], size[1], frame.stamp, passthrough=True,
+                        encode_s=time.perf_counter() - started)
+    picture = decode_compressed(frame, data, output_size_of=lambda w, h: output_size(w, h, width, height, max_pixels))
     return _encode_picture(picture, quality, width, height, frame.stamp, started, max_pixels)
 
 

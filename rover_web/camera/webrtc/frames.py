@@ -16,7 +16,7 @@ import numpy as np
 from PIL import Image
 
 from rover_web.camera import imaging
-from rover_web.camera.imaging import CompressedFrame, FrameError, RawImage
+from rover_web.camera.imaging import CompressedFrame, RawImage
 
 
 @dataclass(frozen=True)
@@ -42,34 +42,14 @@ def _resized(pixels: np.ndarray, width: int | None, height: int | None, max_pixe
     return np.asarray(Image.fromarray(np.ascontiguousarray(pixels)).resize(size, Image.Resampling.BILINEAR))
 
 
-def _decode_compressed(frame: CompressedFrame) -> np.ndarray:
-    if "compresseddepth" in frame.format.lower():
-        raise FrameError("compressedDepth images are not supported; view the raw depth topic instead",
-                         "unsupported_encoding")
-    try:
-        picture = Image.open(io.BytesIO(bytes(frame.data)), formats=imaging.IMAGE_FORMATS)
-        if picture.width * picture.height > imaging.MAX_PIXELS:
-            raise FrameError(f"image is {picture.width}×{picture.height}, more than {imaging.MAX_PIXELS} pixels",
-                             "image_too_large")
-        picture.load()
-    except FrameError:
-        raise
-    except Exception as exc:  # Pillow raises many types for bad data; all mean "cannot decode"
-        raise FrameError(f"cannot decode the {frame.format or 'compressed'} image: {exc}", "bad_image") from None
-    if picture.mode in ("I;16", "I;16B", "I;16L", "I", "F"):
-        values = np.asarray(picture)
-        valid = np.isfinite(values) & (values != 0) if values.dtype.kind == "f" else values > 0
-        return imaging.stretch_to_8bit(values, valid)
-    if picture.mode not in ("RGB", "L"):
-        picture = picture.convert("RGB")
-    return np.asarray(picture)
-
-
 def to_picture(frame: RawImage | CompressedFrame, width: int | None = None, height: int | None = None,
                max_pixels: int | None = None) -> Picture:
     """FrameError for what cannot be shown (see imaging.py)."""
     started = time.perf_counter()
-    pixels = imaging.image_to_array(frame) if isinstance(frame, RawImage) else _decode_compressed(frame)
+    if isinstance(frame, RawImage):
+        pixels = imaging.image_to_array(frame)
+    else:
+        pixels = np.asarray(imaging.decode_compressed(frame))
     out = _resized(pixels, width, height, max_pixels)
     return Picture(out, out.shape[1], out.shape[0], frame.stamp, encode_s=time.perf_counter() - started)
 
