@@ -20,12 +20,27 @@ def pytest_configure(config):
     # Every test session gets its own ROS domain on localhost only, so parallel runs and a robot on
     # the same network never see the test traffic. Set before anything initialises rclpy.
     os.environ.setdefault("ROS_DOMAIN_ID", os.environ.get("ROVER_WEB_TEST_DOMAIN_ID") or str(random.randint(1, 200)))
+    # Under pytest-xdist the workers inherit the controller's domain; each (gw0, gw1, ...) takes
+    # the next one from it, so two workers' peers and servers never meet.
+    worker = os.environ.get("PYTEST_XDIST_WORKER")
+    if worker:
+        base = int(os.environ["ROS_DOMAIN_ID"])
+        os.environ["ROS_DOMAIN_ID"] = str((base + int(worker.removeprefix("gw"))) % 200 + 1)
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     os.environ.pop("ROS_STATIC_PEERS", None)
     # Every ROVER_WEB_* name goes, ROVER_WEB_TEST_DOMAIN_ID too (it is used above): the app refuses
     # unknown ROVER_WEB_* settings, in this process and in the servers and simulators tests start.
     for key in [k for k in os.environ if k.startswith("ROVER_WEB_")]:
         del os.environ[key]
+
+
+def pytest_collection_modifyitems(config, items):
+    # Browser tests run last. Playwright's sync API leaves its asyncio loop marked as running on the
+    # main thread (and greenlet switches in its frames) until the session ends, so a later test's
+    # asyncio.run() fails and ast.parse can raise "AST constructor recursion depth mismatch".
+    # The sort is stable, and pytest-xdist hands tests out in this order, so on every worker no
+    # other test follows one that started Chromium.
+    items.sort(key=lambda item: "browser" in getattr(item, "fixturenames", ()))
 
 
 def free_port() -> int:

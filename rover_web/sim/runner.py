@@ -47,8 +47,10 @@ def run_nodes(make_nodes: Callable[[Context], list]) -> None:
     spinner = threading.Thread(target=_spin, args=(executor, stop), daemon=True)
     spinner.start()
     stop.wait()  # a signal, or the spinner ending on its own; signal handlers still run while waiting
+    # On a loaded machine a callback (the camera encoding a frame) can outlast shutdown's own
+    # timeout: wait for the spinner before the nodes go, or spin() would meet destroyed handles.
     executor.shutdown(timeout_sec=2.0)
-    spinner.join(2.0)
+    spinner.join(10.0)
     for node in nodes:
         node.destroy_node()
     context.try_shutdown()
@@ -61,5 +63,8 @@ def _spin(executor, stop: threading.Event) -> None:
         executor.spin()
     except ExternalShutdownException:
         pass
+    except Exception:
+        if not stop.is_set():  # an error while running is shown; one from handles torn down
+            raise              # under a stopping spinner is the shutdown itself
     finally:
         stop.set()
