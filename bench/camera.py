@@ -17,21 +17,12 @@ import time
 
 import psutil
 import requests
-from common import ROOT, Server, machine, percentile, ros_env
+from common import ROOT, Server, machine, percentile, ros_env, stop_process, wait_for, wait_for_topic
 
 sys.path.insert(0, str(ROOT))
 from tests.support.mjpeg import MjpegClient  # noqa: E402
 
 TOPIC = "/camera/image_raw"
-
-
-def wait_for(predicate, timeout: float, what: str):
-    deadline = time.monotonic() + timeout
-    while not (value := predicate()):
-        if time.monotonic() > deadline:
-            raise RuntimeError(f"{what} did not happen within {timeout} s")
-        time.sleep(0.1)
-    return value
 
 
 def stream_stats(server: Server) -> dict:
@@ -96,8 +87,7 @@ def bench(args, noise: float) -> None:
     server = None
     try:
         server = Server(env)
-        wait_for(lambda: any(t["name"] == TOPIC for t in requests.get(server.url + "/api/topics", timeout=5)
-                             .json()["topics"]), 30, "camera discovery")
+        wait_for_topic(server, TOPIC, "camera discovery")
         print(f"# camera bench on {machine()}: sim camera 640x480 rgb8 30 Hz, grain {noise:g} (own process) -> "
               f"/stream quality {args.quality}, {args.seconds:g} s per run", flush=True)
         for n in args.viewers:
@@ -115,11 +105,7 @@ def bench(args, noise: float) -> None:
     finally:
         if server is not None:
             server.stop()
-        camera_proc.terminate()
-        try:
-            camera_proc.wait(10)
-        except subprocess.TimeoutExpired:
-            camera_proc.kill()
+        stop_process(camera_proc)
 
 
 if __name__ == "__main__":

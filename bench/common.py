@@ -77,13 +77,56 @@ class Server:
 
     def stop(self) -> None:
         if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait(5)
+            stop_process(self.proc)
         self._tmp.cleanup()
+
+
+def stop_process(proc: subprocess.Popen, timeout: float = 10) -> None:
+    """SIGTERM, then SIGKILL if it has not ended within `timeout` s: a bench leaves no process behind."""
+    proc.terminate()
+    try:
+        proc.wait(timeout)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait(5)
+
+
+def wait_for(predicate, timeout: float, what: str):
+    deadline = time.monotonic() + timeout
+    while not (value := predicate()):
+        if time.monotonic() > deadline:
+            raise RuntimeError(f"{what} did not happen within {timeout} s")
+        time.sleep(0.1)
+    return value
+
+
+def wait_for_topic(server: Server, topic: str, what: str, timeout: float = 30) -> None:
+    """Until the app's topic list (GET /api/topics) has `topic`: its node has discovered the publisher."""
+    wait_for(lambda: any(t["name"] == topic for t in requests.get(server.url + "/api/topics", timeout=5)
+                         .json()["topics"]), timeout, what)
+
+
+def count_rtp_payload(receiver, count) -> None:
+    """count(n) with the payload size of each RTP packet an aiortc RTCRtpReceiver gets, before it
+    handles the packet: what the video costs on the wire. aiortc has no public hook, so this wraps
+    its private _handle_rtp_packet, here only."""
+    handle = receiver._handle_rtp_packet
+
+    async def counted(packet, arrival_time_ms):
+        count(len(packet.payload))
+        await handle(packet, arrival_time_ms)
+    receiver._handle_rtp_packet = counted
+
+
+async def decoded_frames(track):
+    """Each frame an aiortc video track decodes, until the track ends."""
+    from aiortc.mediastreams import MediaStreamError  # only the WebRTC benches have aiortc loaded
+
+    while True:
+        try:
+            yield await track.recv()
+        except MediaStreamError:
+            return
 
 
 # Linux's SO_TIMESTAMPNS (Python 3.11's socket module lacks the name): every recvmsg() then says

@@ -48,7 +48,7 @@ import threading
 import time
 
 import requests
-from common import ROOT, WALL_MINUS_MONOTONIC, Server, SseFleet, machine, percentile, ros_env
+from common import ROOT, WALL_MINUS_MONOTONIC, Server, SseFleet, machine, percentile, ros_env, stop_process, wait_for
 
 sys.path.insert(0, str(ROOT))
 from link_webrtc import ChannelSocket, LinkWhep  # noqa: E402
@@ -204,15 +204,6 @@ class Events(threading.Thread):
         self.fleet.close()
 
 
-def wait_for(predicate, timeout: float, what: str):
-    deadline = time.monotonic() + timeout
-    while not (value := predicate()):
-        if time.monotonic() > deadline:
-            raise RuntimeError(f"{what} did not happen within {timeout} s")
-        time.sleep(0.1)
-    return value
-
-
 def ms(values: list[float], p: float) -> float | None:
     return round(percentile(values, p), 1) if values else None
 
@@ -350,11 +341,7 @@ def run(args) -> dict:
             sub.stop()
         if server is not None:
             server.stop()
-        sim.terminate()
-        try:
-            sim.wait(10)
-        except subprocess.TimeoutExpired:
-            sim.kill()
+        stop_process(sim)
         scratch.cleanup()
 
     held_s = t_end - t_start

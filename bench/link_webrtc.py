@@ -30,7 +30,7 @@ import time
 
 import requests
 from aiortc import RTCConfiguration, RTCPeerConnection, RTCSessionDescription
-from aiortc.mediastreams import MediaStreamError
+from common import count_rtp_payload, decoded_frames
 
 from rover_web.camera.webrtc.ice import candidates, filter_candidates, only_host_addresses
 from rover_web.camera.webrtc.loop import LoopThread
@@ -99,12 +99,7 @@ class LinkWhep:
         with only_host_addresses(LOOPBACK):
             self.pc = pc = RTCPeerConnection(RTCConfiguration(iceServers=[]))
             receiver = pc.addTransceiver("video", direction="recvonly").receiver
-            handle = receiver._handle_rtp_packet
-
-            async def counted(packet, arrival_time_ms):  # the payload bytes the link carried for video
-                self._bytes += len(packet.payload)
-                await handle(packet, arrival_time_ms)
-            receiver._handle_rtp_packet = counted
+            count_rtp_payload(receiver, self._count)  # the payload bytes the link carried for video
             if teleop:
                 self.channel = pc.createDataChannel("teleop", ordered=False, maxRetransmits=0)
                 self.channel.on("open", self.channel_open.set)
@@ -117,12 +112,11 @@ class LinkWhep:
             await pc.setLocalDescription(await pc.createOffer())
         return filter_candidates(pc.localDescription.sdp, LOOPBACK)
 
+    def _count(self, n: int) -> None:
+        self._bytes += n
+
     async def _read(self, track) -> None:
-        while True:
-            try:
-                frame = await track.recv()
-            except MediaStreamError:
-                return
+        async for frame in decoded_frames(track):
             t = time.monotonic()
             now_ms = int(time.time() * 1000)
             size, self._bytes = self._bytes, 0

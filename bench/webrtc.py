@@ -23,7 +23,18 @@ import time
 
 import numpy as np
 import requests
-from common import ROOT, Server, machine, percentile, ros_env
+from common import (
+    ROOT,
+    Server,
+    count_rtp_payload,
+    decoded_frames,
+    machine,
+    percentile,
+    ros_env,
+    stop_process,
+    wait_for,
+    wait_for_topic,
+)
 
 sys.path.insert(0, str(ROOT))
 from tests.support.whep import WhepClient  # noqa: E402
@@ -104,25 +115,17 @@ class Viewer:
 
     async def _tap(self) -> None:
         receiver = self.client.pc.getTransceivers()[0].receiver
-        handle = receiver._handle_rtp_packet
-
-        async def counted(packet, arrival_time_ms):
-            self.bytes += len(packet.payload)
-            await handle(packet, arrival_time_ms)
-        receiver._handle_rtp_packet = counted
+        count_rtp_payload(receiver, self._count)
         # Replace the test client's reader: this one decodes to grey and reads the time code.
         if self.client._reader is not None:
             self.client._reader.cancel()
         asyncio.ensure_future(self._read(receiver.track))
 
-    async def _read(self, track) -> None:
-        from aiortc.mediastreams import MediaStreamError
+    def _count(self, n: int) -> None:
+        self.bytes += n
 
-        while True:
-            try:
-                frame = await track.recv()
-            except MediaStreamError:
-                return
+    async def _read(self, track) -> None:
+        async for frame in decoded_frames(track):
             now_ms = int(time.time() * 1000) & 0xFFFFFFFF
             stamp = read_timecode(frame.to_ndarray(format="gray"))
             self.decoded += 1
@@ -133,15 +136,6 @@ class Viewer:
 
     def close(self) -> None:
         self.client.close()
-
-
-def wait_for(predicate, timeout: float, what: str):
-    deadline = time.monotonic() + timeout
-    while not (value := predicate()):
-        if time.monotonic() > deadline:
-            raise RuntimeError(f"{what} did not happen within {timeout} s")
-        time.sleep(0.1)
-    return value
 
 
 def run(server: Server, viewers: int, seconds: float) -> dict:
@@ -193,8 +187,7 @@ def main() -> None:
     try:
         assert camera_proc.stdout.readline().strip() == "ready"
         server = Server(env)
-        wait_for(lambda: any(t["name"] == TOPIC for t in requests.get(server.url + "/api/topics", timeout=5)
-                             .json()["topics"]), 30, "camera discovery")
+        wait_for_topic(server, TOPIC, "camera discovery")
         print(f"# WebRTC bench on {machine()}: {WIDTH}x{HEIGHT} rgb8 {HZ:g} Hz camera (own process) -> WHEP, "
               f"aiortc viewers in the bench process, loopback, {args.seconds:g} s per run", flush=True)
         for n in args.viewers:
@@ -209,11 +202,7 @@ def main() -> None:
     finally:
         if server is not None:
             server.stop()
-        camera_proc.terminate()
-        try:
-            camera_proc.wait(10)
-        except subprocess.TimeoutExpired:
-            camera_proc.kill()
+        stop_process(camera_proc)
 
 
 if __name__ == "__main__":

@@ -19,6 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from rover_web.core import robots
+
 # The checkout (or install) root: templates/, static/ and map_files/ are found from here.
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -297,6 +299,8 @@ SETTINGS: tuple[Setting, ...] = (
 )
 
 _BY_NAME = {PREFIX + s.name: s for s in SETTINGS}
+# The settings that name one ROS topic: core/robots.settings_for resolves them under a namespace.
+TOPIC_KEYS = tuple(PREFIX + s.name for s in SETTINGS if s.kind in ("topic", "optional_topic"))
 
 
 def defaults() -> dict[str, Any]:
@@ -331,9 +335,7 @@ def _from_text(setting: Setting, text: str) -> Any:
         except ValueError:
             return text
     if kind == "robots":
-        from rover_web.core.robots import from_text
-
-        stripped = from_text(stripped)
+        stripped = robots.from_text(stripped)
         if not isinstance(stripped, str):
             return stripped
     if kind in ("list", "robots"):
@@ -372,13 +374,11 @@ def _check(setting: Setting, value: Any, source: str) -> Any:
             raise fail(f"a value from {setting.low:g} to {setting.high:g}")
         return int(value) if kind == "int" else float(value)
     if kind == "robots":
-        from rover_web.core.robots import RobotsError, parse
-
         try:
-            robots = parse(value)
-        except RobotsError as exc:
+            parsed = robots.parse(value)
+        except robots.RobotsError as exc:
             raise ConfigError(f"{name}: {exc} (from {source})") from None
-        return [r.as_dict() for r in robots] if value else []
+        return [r.as_dict() for r in parsed] if value else []
     if kind == "list":
         if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
             raise fail("a list of strings")

@@ -7,6 +7,7 @@ anything starts, and the simulator can share the naming rules.
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
@@ -109,19 +110,18 @@ def parse(value: Any) -> list[Robot]:
 NAME_LISTS = ("ROVER_WEB_LINK_TOPICS", "ROVER_WEB_ESTOP_CANCEL_ACTIONS")
 
 
-def settings_for(robot: Robot, settings: dict[str, Any]) -> dict[str, Any]:
+def settings_for(robot: Robot, settings: dict[str, Any], topic_keys: Iterable[str]) -> dict[str, Any]:
     """The settings one robot's features read: every ROS name resolved under its namespace.
 
+    `topic_keys` are the settings that name one topic (config.TOPIC_KEYS): they are passed in
+    because config.py imports this module to check ROVER_WEB_ROBOTS, and not the other way round.
     A robot without a namespace (the one robot of old) reads the settings as they are.
     """
-    from rover_web.config import PREFIX, SETTINGS
-
     if not robot.namespace:
         return settings
     mine = dict(settings)
-    for setting in SETTINGS:
-        key = PREFIX + setting.name
-        if setting.kind in ("topic", "optional_topic") and mine[key]:
+    for key in topic_keys:
+        if mine[key]:
             mine[key] = robot.resolve(mine[key])
     for key in NAME_LISTS:
         mine[key] = [robot.resolve(name) for name in mine[key]]

@@ -22,6 +22,7 @@ from typing import Any
 
 from flask import Flask
 
+from rover_web.config import TOPIC_KEYS
 from rover_web.core import robots as robots_setting
 from rover_web.core.fleet import Fleet, FleetHub
 from rover_web.core.state import Rover
@@ -51,7 +52,7 @@ def build_fleet(settings: dict[str, Any], runtime, db_path: Path, db_claim) -> F
     claims = []  # the ones made here; the caller releases db_claim if this fails
     try:
         for i, robot in enumerate(robots):
-            config = robots_setting.settings_for(robot, settings)
+            config = robots_setting.settings_for(robot, settings, TOPIC_KEYS)
             path = db_path if i == 0 else robot_database(db_path, robot.name)
             held = db_claim
             if i:

@@ -17,7 +17,7 @@ def scalar_message(type_name: str, value: Any):
     """A fresh std_msgs/<Scalar> or String with `data` = value (already checked by the panel spec).
 
     rclpy does not range-check fields (its checks are off by default), so an Int8 of 200 would go
-    out wrapped; callers validate first (rover_web.panels.spec.coerce).
+    out wrapped; callers validate first (rover_web.panels.scalars.coerce).
     """
     msg = message_class(type_name)()
     field_type = msg.get_fields_and_field_types()["data"]

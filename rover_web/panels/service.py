@@ -21,7 +21,8 @@ from rover_web.web.validate import InvalidInput, only_keys
 
 from . import msgs
 from .oplog import OperatorLog
-from .spec import ControlSpec, InvalidValue, PanelSpec
+from .scalars import InvalidValue
+from .spec import ControlSpec, PanelSpec
 from .state import PanelState
 
 log = logging.getLogger(__name__)

@@ -13,7 +13,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from .spec import ControlSpec, DisplaySpec, InvalidValue, PanelSpec, coerce
+from .scalars import InvalidValue, coerce
+from .spec import ControlSpec, DisplaySpec, PanelSpec
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ import time
 
 import pytest
 
-from tests.support.delay_proxy import DelayProxy
+from rover_web.linkemu import LinkEmulator, profile
 from tests.support.teleop_support import is_zero, subscribe_cmd_vel, twists, warm_up
 
 pytestmark = pytest.mark.browser
@@ -25,6 +25,12 @@ def rig(live_server_factory, ros_peer):
     subscribe_cmd_vel(peer)
     warm_up(peer, server.url)
     return server, peer
+
+
+def long_link(delay_ms: float):
+    """Only a one-way delay, changeable live (LinkEmulator.set_profile): no cap worth the name, a
+    deep buffer, no jitter, loss, stalls or outages (bench/link.py's loopback control, delayed)."""
+    return profile("custom", rate_kbps=1_000_000, buffer_kb=4096, delay_ms=delay_ms)
 
 
 def open_dashboard(page, server):
@@ -257,15 +263,15 @@ def test_second_browser_is_view_only_and_can_take_over(rig, browser):
 
 
 def test_the_drive_card_shows_the_link_and_says_plainly_when_it_is_too_poor(rig, page):
-    """The page goes through a proxy whose delay is turned up once it is live: the server's own
-    measurement of the page's socket (pings the browser answers) reaches the card, and so does the
-    verdict. The page's drive frames carry seq and t."""
+    """The page goes through the link emulator, whose delay is turned up once the page is live: the
+    server's own measurement of the page's socket (pings the browser answers) reaches the card, and
+    so does the verdict. The page's drive frames carry seq and t."""
     server, peer = rig
-    proxy = DelayProxy(server.port)
+    link = LinkEmulator(long_link(0), "127.0.0.1:0", ("127.0.0.1", server.port)).start()
     sent = []
     page.on("websocket", lambda ws: ws.on("framesent", lambda payload: sent.append(payload)))
     try:
-        page.goto(proxy.url + "/")
+        page.goto(f"http://127.0.0.1:{link.port}/")
         page.wait_for_selector("#teleop-link[data-state='live']", timeout=10000)
         page.wait_for_function("document.getElementById('teleop-rtt').textContent.endsWith(' ms')", timeout=10000)
         linkq = page.locator("#teleop-linkq")
@@ -286,7 +292,7 @@ def test_the_drive_card_shows_the_link_and_says_plainly_when_it_is_too_poor(rig,
         page.wait_for_function("document.getElementById('teleop-jitter').textContent.endsWith(' ms')",
                                timeout=5000)
 
-        proxy.delay_s = 0.45  # each way: a 900 ms round trip
+        link.set_profile(long_link(450))  # each way: a 900 ms round trip
         banner = page.locator("#teleop-link-banner")
         banner.wait_for(state="visible", timeout=20000)
         text = banner.inner_text()
@@ -296,9 +302,9 @@ def test_the_drive_card_shows_the_link_and_says_plainly_when_it_is_too_poor(rig,
         page.wait_for_function("document.getElementById('teleop-quality').textContent === 'too poor' && "
                                "parseInt(document.getElementById('teleop-rtt').textContent) >= 800", timeout=10000)
 
-        proxy.delay_s = 0.0  # the link recovers: so does the card
+        link.set_profile(long_link(0))  # the link recovers: so does the card
         banner.wait_for(state="hidden", timeout=30000)
         assert linkq.get_attribute("data-quality") in ("ok", "poor")
         assert page.watch.console_errors == []
     finally:
-        proxy.close()
+        link.stop()

@@ -9,8 +9,8 @@ import time
 
 import pytest
 
+from rover_web.linkemu import LinkEmulator, profile
 from rover_web.teleop.link import QUALITIES
-from tests.support.delay_proxy import DelayProxy
 from tests.support.teleop_support import StallingProxy, TeleopClient, is_zero, subscribe_cmd_vel, twists, warm_up
 
 
@@ -20,6 +20,12 @@ def rig(live_server, ros_peer):
     subscribe_cmd_vel(peer)
     warm_up(peer, live_server.url)
     return live_server, peer
+
+
+def long_link(delay_ms: float):
+    """Only a one-way delay, changeable live (LinkEmulator.set_profile): no cap worth the name, a
+    deep buffer, no jitter, loss, stalls or outages (bench/link.py's loopback control, delayed)."""
+    return profile("custom", rate_kbps=1_000_000, buffer_kb=4096, delay_ms=delay_ms)
 
 
 class Page:
@@ -152,13 +158,10 @@ def test_frames_whose_send_times_jitter_by_300_ms_make_the_link_too_poor(rig):
 
 
 def test_a_long_round_trip_makes_the_link_too_poor(live_server):
-    proxy = DelayProxy(live_server.port)
-    try:
-        client = TeleopClient(proxy.url)
-        proxy.delay_s = 0.45  # each way
+    with LinkEmulator(long_link(0), "127.0.0.1:0", ("127.0.0.1", live_server.port)) as link:
+        client = TeleopClient(f"http://127.0.0.1:{link.port}")
+        link.set_profile(long_link(450))  # each way
         report = client.wait_for(lambda m: m.get("reason") == "link" and (m["link"]["rtt_ms"] or 0) >= 800,
                                  timeout=20)["link"]
         assert report["quality"] == "too_poor" and "round trip" in report["why"]
         client.close()
-    finally:
-        proxy.close()

@@ -74,7 +74,7 @@ def test_resolve_puts_configured_names_under_the_namespace():
 def test_settings_for_resolves_every_topic_and_name_list():
     settings = config.load({}, environ={})
     boat = Robot("boat", "/boat")
-    mine = settings_for(boat, settings)
+    mine = settings_for(boat, settings, config.TOPIC_KEYS)
     assert mine is not settings
     assert mine["ROVER_WEB_CMD_VEL_TOPIC"] == "/boat/cmd_vel"
     assert mine["ROVER_WEB_ESTOP_TOPIC"] == "/boat/e_stop"
@@ -94,9 +94,10 @@ def test_settings_for_resolves_every_topic_and_name_list():
 
 def test_settings_for_the_one_robot_of_old_are_the_settings():
     settings = config.load({}, environ={})
-    assert settings_for(Robot("robot"), settings) is settings
+    assert settings_for(Robot("robot"), settings, config.TOPIC_KEYS) is settings
     # A first robot with a namespace resolves like any other.
-    assert settings_for(Robot("boat", "/boat"), settings)["ROVER_WEB_CMD_VEL_TOPIC"] == "/boat/cmd_vel"
+    boat = settings_for(Robot("boat", "/boat"), settings, config.TOPIC_KEYS)
+    assert boat["ROVER_WEB_CMD_VEL_TOPIC"] == "/boat/cmd_vel"
 
 
 def test_config_keeps_the_parsed_robots_and_names_the_setting_when_wrong():

@@ -8,7 +8,7 @@ from sensor_msgs.msg import NavSatFix
 from std_msgs.msg import Float32
 
 from rover_web.panels.msgs import field_kind, read_field, scalar_message
-from rover_web.panels.spec import SCALAR_TYPES
+from rover_web.panels.scalars import SCALAR_TYPES
 
 EXAMPLES = {
     "Bool": True, "Byte": 200, "Char": 65, "Int8": -128, "UInt8": 255, "Int16": -32768, "UInt16": 65535,

@@ -6,7 +6,7 @@ import math
 import pytest
 
 from rover_web.config import ConfigError
-from rover_web.panels import spec
+from rover_web.panels import scalars, spec
 from rover_web.panels.msgs import field_kind
 
 
@@ -76,44 +76,44 @@ def test_a_valid_file_parses_with_defaults():
     ("std_msgs/msg/Int64", -2**63, 2**63 - 1), ("std_msgs/msg/UInt64", 0, 2**64 - 1),
 ])
 def test_integer_ranges_respect_the_type(type_name, low, high):
-    stype = spec.SCALAR_TYPES[type_name]
-    assert spec.coerce(stype, low) == low and spec.coerce(stype, high) == high
+    stype = scalars.SCALAR_TYPES[type_name]
+    assert scalars.coerce(stype, low) == low and scalars.coerce(stype, high) == high
     for outside in (low - 1, high + 1):
-        with pytest.raises(spec.InvalidValue) as err:
-            spec.coerce(stype, outside)
+        with pytest.raises(scalars.InvalidValue) as err:
+            scalars.coerce(stype, outside)
         assert err.value.code == "out_of_range" and f"from {low} to {high}" in str(err.value)
-    assert spec.coerce(stype, 3.0) == 3  # an integral JSON number is fine
+    assert scalars.coerce(stype, 3.0) == 3  # an integral JSON number is fine
     for wrong, code in ((2.5, "bad_type"), (True, "bad_type"), ("3", "bad_type"), (math.inf, "non_finite")):
-        with pytest.raises(spec.InvalidValue) as err:
-            spec.coerce(stype, wrong)
+        with pytest.raises(scalars.InvalidValue) as err:
+            scalars.coerce(stype, wrong)
         assert err.value.code == code
 
 
 def test_float_bool_and_string_values():
-    f32, f64 = spec.SCALAR_TYPES["std_msgs/msg/Float32"], spec.SCALAR_TYPES["std_msgs/msg/Float64"]
-    assert spec.coerce(f32, 1) == 1.0 and isinstance(spec.coerce(f32, 1), float)
-    with pytest.raises(spec.InvalidValue, match="out|from"):
-        spec.coerce(f32, 1e39)  # fits a double, not a float
-    assert spec.coerce(f64, 1e300) == 1e300
+    f32, f64 = scalars.SCALAR_TYPES["std_msgs/msg/Float32"], scalars.SCALAR_TYPES["std_msgs/msg/Float64"]
+    assert scalars.coerce(f32, 1) == 1.0 and isinstance(scalars.coerce(f32, 1), float)
+    with pytest.raises(scalars.InvalidValue, match="out|from"):
+        scalars.coerce(f32, 1e39)  # fits a double, not a float
+    assert scalars.coerce(f64, 1e300) == 1e300
     for huge in (10 ** 400, -10 ** 400):  # valid JSON; float() of it would raise OverflowError
-        with pytest.raises(spec.InvalidValue) as err:
-            spec.coerce(f64, huge)
+        with pytest.raises(scalars.InvalidValue) as err:
+            scalars.coerce(f64, huge)
         assert err.value.code == "out_of_range" and "401 digits" in str(err.value)
     for bad in (math.nan, math.inf, -math.inf):
-        with pytest.raises(spec.InvalidValue) as err:
-            spec.coerce(f64, bad)
+        with pytest.raises(scalars.InvalidValue) as err:
+            scalars.coerce(f64, bad)
         assert err.value.code == "non_finite"
-    boolean = spec.SCALAR_TYPES["std_msgs/msg/Bool"]
-    assert spec.coerce(boolean, False) is False
-    with pytest.raises(spec.InvalidValue, match="true or false"):
-        spec.coerce(boolean, 1)
-    string = spec.SCALAR_TYPES["std_msgs/msg/String"]
-    assert spec.coerce(string, "hello") == "hello"
-    with pytest.raises(spec.InvalidValue) as err:
-        spec.coerce(string, "x" * 11, max_length=10)
+    boolean = scalars.SCALAR_TYPES["std_msgs/msg/Bool"]
+    assert scalars.coerce(boolean, False) is False
+    with pytest.raises(scalars.InvalidValue, match="true or false"):
+        scalars.coerce(boolean, 1)
+    string = scalars.SCALAR_TYPES["std_msgs/msg/String"]
+    assert scalars.coerce(string, "hello") == "hello"
+    with pytest.raises(scalars.InvalidValue) as err:
+        scalars.coerce(string, "x" * 11, max_length=10)
     assert err.value.code == "too_long"
-    with pytest.raises(spec.InvalidValue, match="must be a string"):
-        spec.coerce(string, 5)
+    with pytest.raises(scalars.InvalidValue, match="must be a string"):
+        scalars.coerce(string, 5)
 
 
 def _set(path, value):

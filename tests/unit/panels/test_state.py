@@ -2,7 +2,7 @@
 
 import pytest
 
-from rover_web.panels import spec
+from rover_web.panels import scalars, spec
 from rover_web.panels.msgs import field_kind
 from rover_web.panels.state import PanelState, format_value
 
@@ -110,10 +110,10 @@ def test_input_values_are_checked_against_the_control_range(drone):
     for body, code in (({}, "missing_field"), ({"value": None}, "missing_field"), ({"value": 128}, "out_of_range"),
                        ({"value": -1}, "out_of_range"), ({"value": "7"}, "bad_type"), ({"value": 1.5}, "bad_type"),
                        ({"value": True}, "bad_type")):
-        with pytest.raises(spec.InvalidValue) as err:
+        with pytest.raises(scalars.InvalidValue) as err:
             state.value_for(destination, body)
         assert err.value.code == code
-    with pytest.raises(spec.InvalidValue, match=r"'value' must be from 0 to 127 for std_msgs/Int8, got 128"):
+    with pytest.raises(scalars.InvalidValue, match=r"'value' must be from 0 to 127 for std_msgs/Int8, got 128"):
         state.value_for(destination, {"value": 128})
     assert state.value_for(control(state, "takeoff"), {}) == 1  # a button publishes its own value
 

@@ -52,7 +52,8 @@ def test_every_name_pattern_refuses_a_trailing_newline():
     """Each pattern that accepts a name must refuse that name with a newline after it."""
     from rover_web.config import TOPIC_PATTERN
     from rover_web.events.hub import CHANNEL_RE
-    from rover_web.panels.spec import _TYPE_NAME_RE, ID_RE
+    from rover_web.panels.file_fields import ID_RE
+    from rover_web.panels.scalars import _TYPE_NAME_RE
     from rover_web.scan_the_code.light_sequence import COLOUR_NAME_RE
 
     for pattern, good in [(TOPIC_PATTERN, "/cmd_vel"), (CHANNEL_RE, "telemetry"), (ID_RE, "drone"),
