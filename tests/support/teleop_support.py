@@ -267,7 +267,9 @@ def is_zero(msg: dict) -> bool:
 
 
 def subscribe_cmd_vel(peer, type_name: str = TWIST, topic: str = "/cmd_vel") -> None:
-    peer.subscribe(topic, type_name, max_items=8)
+    # Keep-last 1000: a peer process starved of CPU by a parallel run must not drop commands from
+    # its reader's history before it takes them (the default keeps 10).
+    peer.subscribe(topic, type_name, qos=1000, max_items=8)
     peer.wait_match(topic)
 
 

@@ -136,7 +136,8 @@ def test_state_frames_carry_the_link_twice_a_second(rig):
     Page(client).hold(0.0, 1.0)  # neutral frames: measured, nothing moves
     t0 = time.monotonic()
     client.wait_for(lambda m: len(link_states(client, t0)) >= 2)
-    report = client.wait_for(lambda m: m.get("reason") == "link" and m["link"]["rtt_ms"] is not None)["link"]
+    report = client.wait_for(lambda m: m.get("reason") == "link" and m["link"]["rtt_ms"] is not None
+                             and m["link"]["jitter_ms"] is not None)["link"]
     assert report["rtt_ms"] >= 0 and report["jitter_ms"] is not None and report["quality"] in QUALITIES
     client.close()
 
