@@ -146,10 +146,13 @@ def spurious_stops(twists, start: float, end: float, outages: list[tuple[float, 
 
 
 class Viewer:
-    """An MJPEG viewer through the link; a thread decodes each frame's time code as frames arrive."""
+    """An MJPEG viewer through the link; a thread decodes each frame's time code as frames arrive.
+    With `ack`, it acknowledges the bytes it receives as the camera card's page does (GET
+    /stream?ack=1, POST /api/camera/viewers/<id>/ack through the same link, one ack in flight):
+    only when the server names the stream (adaptation on; an older build ignores ack=1)."""
 
-    def __init__(self, url: str):
-        self.client = MjpegClient(f"{url}/stream?topic={TOPIC}")
+    def __init__(self, url: str, ack: bool = True):
+        self.client = MjpegClient(f"{url}/stream?topic={TOPIC}" + ("&ack=1" if ack else ""), ack=ack)
         self.samples: list[tuple[float, float | None, int]] = []  # (arrival monotonic, age ms or None, bytes)
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._decode, daemon=True)
@@ -301,7 +304,7 @@ def run(args) -> dict:
         if webrtc:
             viewer = LinkWhep(emu, url, TOPIC, teleop=args.teleop == "datachannel")
         elif args.camera == "on":
-            viewer = Viewer(url)
+            viewer = Viewer(url, ack=args.adapt != "off")  # a page acknowledges when the server adapts
         if viewer is not None:
             wait_for(lambda: viewer.samples, 60, "the first camera frame through the link")
         if args.teleop == "datachannel":

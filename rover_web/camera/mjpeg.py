@@ -10,8 +10,10 @@ OPENING = f"--{BOUNDARY}\r\n".encode()  # sent first, so the headers go out befo
 PART_END = b"\r\n" + OPENING
 
 
-def multipart_part(jpeg: Jpeg) -> bytes:
-    """One JPEG and the boundary after it, so a browser shows the frame as soon as it arrives."""
+def multipart_part(jpeg: Jpeg, seq: int | None = None) -> bytes:
+    """One JPEG and the boundary after it, so a browser shows the frame as soon as it arrives.
+    `seq` (acknowledged streams): the part's number on its stream, from 1, as X-Frame-Seq."""
+    numbered = "" if seq is None else f"X-Frame-Seq: {seq}\r\n"
     head = (f"Content-Type: image/jpeg\r\nContent-Length: {len(jpeg.data)}\r\n"
-            f"X-Timestamp: {jpeg.stamp:.9f}\r\n\r\n").encode()
+            f"X-Timestamp: {jpeg.stamp:.9f}\r\n{numbered}\r\n").encode()
     return head + jpeg.data + PART_END

@@ -1,6 +1,6 @@
 """Camera routes, for GET /api/openapi.json (see rover_web/apidocs/describe.py)."""
 
-from rover_web.apidocs.describe import obj, op, query
+from rover_web.apidocs.describe import BODY_ERRORS, obj, op, path, query
 
 PARAMS = [
     query("topic", {"type": "string", "minLength": 1}, "the image topic, e.g. /camera/image_raw", required=True),
@@ -15,14 +15,18 @@ PARAMS = [
 ]
 VIEWER = query("viewer", {"type": "string", "pattern": "^[A-Za-z0-9_-]{1,64}$"},
                "a label the page tags its stream with, to find it in GET /api/camera/viewers")
+ACK = query("ack", {"type": "string", "enum": ["0", "1"]},
+            "1: the page will acknowledge the bytes it receives (POST /api/camera/viewers/{viewer_id}/ack), so "
+            "the server sees the queue even behind a hop that terminates TCP; the response's X-Camera-Viewer "
+            "header names the stream and each part carries X-Frame-Seq (adaptive streams only)")
 BAD = ("missing_topic, bad_topic, bad_value, out_of_range, unsupported_stream_type, type_mismatch, "
        "not_an_image_topic, unknown_type")
 
 PATHS = {
     "/stream": {
         "get": op("An MJPEG stream of an image topic", tag="camera", media="multipart/x-mixed-replace",
-                  ok={"type": "string"}, params=[*PARAMS, VIEWER],
-                  errors={400: BAD + ", bad_value (viewer)", 404: "unknown_topic",
+                  ok={"type": "string"}, params=[*PARAMS, VIEWER, ACK],
+                  errors={400: BAD + ", bad_value (viewer, ack)", 404: "unknown_topic",
                           503: "too_many_viewers, too_many_producers, too_many_streams, shutting_down"},
                   extra={"x-stream": "mjpeg"}),
     },
@@ -40,5 +44,20 @@ PATHS = {
                       query("viewer", {"type": "string", "pattern": "^[A-Za-z0-9_-]{1,64}$"},
                             "only the viewers whose stream carried this label")],
                   errors={400: "bad_value"}),
+    },
+    "/api/camera/viewers/{viewer_id}/ack": {
+        "post": op("An acknowledging MJPEG page says how many body bytes of its stream it has received in all",
+                   tag="camera", status=204, ok={},
+                   params=[path("viewer_id", {"type": "string", "maxLength": 64},
+                                "the X-Camera-Viewer header of GET /stream?ack=1")],
+                   body=obj({"bytes": {"type": "integer", "minimum": 0,
+                                       "description": "body bytes received on the stream in all; a count "
+                                                      "smaller than one already acknowledged is ignored"}},
+                            required=("bytes",)),
+                   errors={**BODY_ERRORS, 400: "missing_body, bad_json, non_finite, unknown_field, missing_field, "
+                                              "bad_type, out_of_range (more than the server has sent)",
+                           404: "unknown_viewer (ended, never opened, or opened by someone else)"},
+                   description="The server keeps its rate control's queue at the bytes sent and not yet "
+                               "acknowledged (docs/camera.md#acknowledging-pages)."),
     },
 }

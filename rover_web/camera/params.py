@@ -61,3 +61,14 @@ def viewer_label(args: Mapping[str, str]) -> str | None:
     if not VIEWER_LABEL.match(label):
         raise InvalidInput("'viewer' must be 1 to 64 letters, digits, '-' or '_'", "bad_value")
     return label
+
+
+def wants_acks(args: Mapping[str, str]) -> bool:
+    """`ack=1`: the page will acknowledge the bytes it receives (acks.py); `ack=0` or none: it will not."""
+    value = args.get("ack")
+    if value is None or value in ("", "0"):
+        return False
+    if value != "1":
+        raise InvalidInput(f"'ack' must be 1 (the page acknowledges what it receives) or 0; got {value[:20]!r}",
+                           "bad_value")
+    return True

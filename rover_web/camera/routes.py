@@ -1,5 +1,6 @@
-"""GET /stream (MJPEG), GET /snapshot (one JPEG), GET /api/camera/streams (who watches what) and
-GET /api/camera/viewers (what each viewer gets)."""
+"""GET /stream (MJPEG), GET /snapshot (one JPEG), GET /api/camera/streams (who watches what),
+GET /api/camera/viewers (what each viewer gets) and POST /api/camera/viewers/<id>/ack (what a
+page acknowledging its stream has received, acks.py)."""
 
 from __future__ import annotations
 
@@ -11,12 +12,13 @@ from rover_web.auth import signed_in_name
 from rover_web.core.leases import Closed, Full
 from rover_web.core.state import current_feature
 from rover_web.web.connection import peer_gone
-from rover_web.web.http import ApiError, error_response, too_many
+from rover_web.web.http import ApiError, error_response, json_body, too_many
 from rover_web.web.streams import once, opening, refuse_cross_site
-from rover_web.web.validate import InvalidInput
+from rover_web.web.validate import InvalidInput, only_keys
 
+from .acks import AckedStream
 from .mjpeg import MIMETYPE, OPENING, multipart_part
-from .params import viewer_label
+from .params import viewer_label, wants_acks
 from .rate import Step
 from .sendq import queued_bytes
 from .service import CameraStreams, CannotSubscribe, Client, StreamRefused, Unavailable, UnknownTopic
@@ -49,8 +51,9 @@ def stream():
     with opening("mjpeg") as slot:
         key = streams.key_for(request.args)
         label = viewer_label(request.args)
+        acks = wants_acks(request.args)
         producer = streams.acquire(key, slot.client)
-    client = streams.client(key, label, slot.client)
+    client = streams.client(key, label, slot.client, acks_from=signed_in_name() if acks else False)
     # The viewer may move to other outputs of its topic (adaptation): release the one it holds last.
     release = once(lambda: streams.release(client.key, client.owner), slot.release,
                    lambda: streams.client_left(client))
@@ -58,8 +61,10 @@ def stream():
     sock = request.environ.get("werkzeug.socket") or request.environ.get("gunicorn.socket")
     stopping = streams.rover.stopping
     frames = adaptive_frames if client.rate is not None else plain_frames
-    response = Response(frames(streams, client, producer, sock, stopping), mimetype=MIMETYPE,
-                        headers={**NO_CACHE, "X-Accel-Buffering": "no"})
+    headers = {**NO_CACHE, "X-Accel-Buffering": "no"}
+    if client.acks is not None:  # with adaptation off there is nothing to acknowledge to: no header
+        headers["X-Camera-Viewer"] = client.acks.id
+    response = Response(frames(streams, client, producer, sock, stopping), mimetype=MIMETYPE, headers=headers)
     # WSGI servers call close() however the response ends (done, browser gone, error), even if
     # the generator never started, so the viewer is always released exactly once.
     response.call_on_close(release)
@@ -91,16 +96,32 @@ def adaptive_frames(streams: CameraStreams, client: Client, producer: FrameProdu
     (quality, size) the rate control chose, wait until the socket has let the last frame go
     down to a small budget, and write the newest frame then. Code after a `yield` runs once the
     server has handed the part to the socket."""
+    acks = client.acks
+    if acks is not None:
+        acks.wrote(len(OPENING))
     yield OPENING
     rate = client.rate
     seq, in_use, base = 0, 0, None  # base: the size of a full-size frame, for the smaller steps
+    parts = 0
     checked = time.monotonic()
     rate_read = -SOURCE_RATE_EVERY_S
 
+    def queued() -> int:
+        """What stands between the server and the viewer: the socket's queue, or for an
+        acknowledging page what it has not received yet, whichever is more (acks.py)."""
+        socket = queued_bytes(sock)
+        return (socket or 0) if acks is None else acks.queued(socket)
+
+    def gone() -> bool:
+        return peer_gone(sock) or stalled(acks)
+
     def wait(seconds: float) -> bool:
-        """False when the stream must end (shutdown, or the browser went away)."""
+        """False when the stream must end (shutdown, the browser went away, or its page stopped
+        acknowledging)."""
         nonlocal checked
         now = time.monotonic()
+        if stalled(acks):
+            return False
         if now - checked >= LIVENESS_CHECK_S:
             checked = now
             if peer_gone(sock):
@@ -108,7 +129,7 @@ def adaptive_frames(streams: CameraStreams, client: Client, producer: FrameProdu
         return not stopping.wait(min(seconds, 0.05))
 
     while not stopping.is_set():
-        pause = rate.pace_s(lambda: queued_bytes(sock) or 0)
+        pause = rate.pace_s(queued)
         if pause > 0:
             if not wait(pause):
                 return
@@ -128,11 +149,11 @@ def adaptive_frames(streams: CameraStreams, client: Client, producer: FrameProdu
             got = producer.next_frame(seq, LIVENESS_CHECK_S)
             if got is None:
                 checked = time.monotonic()
-                if peer_gone(sock):
+                if gone():
                     return
                 continue
             held = False
-            while (hold := rate.hold_s(queued_bytes(sock) or 0)) > 0:
+            while (hold := rate.hold_s(queued())) > 0:
                 held = True
                 if not wait(hold):
                     return
@@ -143,10 +164,22 @@ def adaptive_frames(streams: CameraStreams, client: Client, producer: FrameProdu
         seq, jpeg = got
         if in_use == 0 and jpeg.error is None:
             base = (jpeg.width, jpeg.height)
-        part = multipart_part(jpeg)
-        started, before = time.monotonic(), queued_bytes(sock) or 0
+        if acks is None:
+            part = multipart_part(jpeg)
+        else:
+            parts += 1
+            part = multipart_part(jpeg, parts)
+        started, before = time.monotonic(), queued()
+        if acks is not None:
+            acks.wrote(len(part))  # before the write: the page may acknowledge it before the yield returns
         yield part
         rate.sent(len(part), started, before, size=(jpeg.width, jpeg.height), step_index=in_use)
+
+
+def stalled(acks: AckedStream | None) -> bool:
+    """An acknowledging page that has said nothing for ACK_STALL_S with bytes outstanding is ended
+    (its page reconnects): it must not hold a stream and a thread for ever."""
+    return acks is not None and acks.stalled()
 
 
 def output_key(asked: StreamKey, step: Step, base: tuple[int, int] | None) -> StreamKey:
@@ -188,6 +221,22 @@ def snapshot():
 def streams_status():
     streams = current_feature(CameraStreams)
     return jsonify(viewers=streams.viewers, streams=streams.describe())
+
+
+@bp.post("/api/camera/viewers/<viewer_id>/ack")
+def viewer_ack(viewer_id: str):
+    """The page of an acknowledged stream has received `bytes` body bytes on it in all."""
+    streams = current_feature(CameraStreams)
+    acked = streams.acked.find(viewer_id[:64], signed_in_name())
+    if acked is None:  # unknown, ended, or another identity's: the same answer, so ids are not revealed
+        raise ApiError(404, "unknown_viewer", "no such acknowledged camera stream (it ended, or was never "
+                                              "opened by you); open GET /stream?ack=1 again")
+    body = json_body()
+    only_keys(body, {"bytes"})
+    if "bytes" not in body:
+        raise InvalidInput("'bytes' is required: the body bytes received on the stream in all", "missing_field")
+    acked.ack(body["bytes"])
+    return Response(status=204)
 
 
 @bp.get("/api/camera/viewers")

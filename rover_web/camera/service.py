@@ -15,6 +15,7 @@ from rover_web.web.validate import InvalidInput
 
 from . import imaging
 from . import msgs as camera_msgs
+from .acks import AckedStream, AckedStreams
 from .params import parse_stream_args
 from .rate import Budget, Meter, ViewerRate
 from .stream import FrameProducer, FrameSource, SourceKey, StreamKey, source_key
@@ -49,12 +50,15 @@ class Client:
         self.id, self.label, self.asked, self.key, self.rate = id, label, key, key, rate
         self.owner: str | None = None
         self.meter = rate.meter if rate is not None else Meter()
+        self.acks: AckedStream | None = None  # an acknowledging page's counts (GET /stream?ack=1)
 
     def report(self) -> dict:
         report = self.rate.report() if self.rate is not None else self.meter.report()
+        acks = self.acks.report() if self.acks is not None else {}
         return {"id": self.id, "viewer": self.label, "topic": self.asked.topic, "adapt": self.rate is not None,
+                "acked": self.acks is not None,
                 "asked": {"width": self.asked.width, "height": self.asked.height, "quality": self.asked.quality},
-                **report}
+                **report, **acks}
 
 
 class CameraStreams:
@@ -78,6 +82,7 @@ class CameraStreams:
         self._sources: dict[SourceKey, FrameSource] = {}
         self._source_lock = threading.Lock()
         self._clients: dict[int, Client] = {}
+        self.acked = AckedStreams()  # the streams whose pages acknowledge, by their unguessable id
         self._next_client = 0
         self._viewers = 0
         self._lock = threading.Lock()
@@ -192,19 +197,26 @@ class CameraStreams:
 
     # --- viewers, for the camera card and the rate control ---
 
-    def client(self, key: StreamKey, label: str | None, owner: str | None = None) -> Client:
-        """A viewer's record: its rate control (or only a meter with adaptation off) and what it watches."""
+    def client(self, key: StreamKey, label: str | None, owner: str | None = None, *,
+               acks_from: str | None | bool = False) -> Client:
+        """A viewer's record: its rate control (or only a meter with adaptation off) and what it watches.
+        `acks_from`: the signed-in name (or None) of a page that will acknowledge what it receives;
+        False for one that will not. Only an adaptive stream uses acknowledgements."""
         rate = ViewerRate(key.quality, max_bps=self.viewer_max_bps, budget=self.budget) if self.adapt else None
         with self._lock:
             self._next_client += 1
             client = Client(self._next_client, label, key, rate)
             client.owner = owner  # whose share of the encodings it holds (web/streams.py)
             self._clients[client.id] = client
+        if rate is not None and acks_from is not False:
+            client.acks = self.acked.open(acks_from)
         return client
 
     def client_left(self, client: Client) -> None:
         with self._lock:
             self._clients.pop(client.id, None)
+        if client.acks is not None:
+            self.acked.close(client.acks)  # its acks are 404 from now on
         if client.rate is not None:
             client.rate.close()
 

@@ -1,11 +1,15 @@
 // Camera panel: an MJPEG <img> of the chosen image topic (GET /stream). The stream is dropped
 // while the tab is hidden, so the server can remove its subscription, and it is only requested
 // for topics the ROS graph lists as images, so a missing camera is a message, not a failed request.
-// Under the image: the fps, size and kbit/s this viewer gets (camera/stats.js); for the slowest
-// links a snapshot mode polls GET /snapshot instead (camera/snapshots.js), suggested when the
-// stream's rate is very low, and remembered per browser.
+// Where the browser can read a response as it arrives, the page reads the MJPEG itself and
+// acknowledges what it received (camera/acked_stream.js), so the server sees the link's queue even
+// behind a hop that terminates TCP; otherwise the <img> plays the stream (img.dataset.transport
+// says which). Under the image: the fps, size and kbit/s this viewer gets (camera/stats.js); for
+// the slowest links a snapshot mode polls GET /snapshot instead (camera/snapshots.js), suggested
+// when the stream's rate is very low, and remembered per browser.
 
 import { api, at } from './api.js';
+import { playAcked, supported as ackedSupported } from './camera/acked_stream.js';
 import { describe, watchViewer } from './camera/stats.js';
 import { pollSnapshots } from './camera/snapshots.js';
 import { play as playWebRtc, stop as stopWebRtc } from './camera/webrtc.js';
@@ -37,6 +41,7 @@ if (card) {
   let imageTopics = new Set((card.dataset.imageTopics || '').split(' ').filter(Boolean));
   let topic = localStorage.getItem(STORAGE_KEY) || select.value || card.dataset.defaultTopic;
   let streaming = null;  // the URL being shown, or null
+  let stopAcked = null;  // stops the acknowledged reader, while it plays
   let recheckTimer = null;
 
   const query = (t) => `topic=${encodeURIComponent(t)}`;
@@ -53,10 +58,20 @@ if (card) {
 
   function stop() {
     if (stopWatching) { stopWatching(); stopWatching = null; }
+    if (stopAcked) { stopAcked(); stopAcked = null; }  // aborts its request: the server releases the stream
     stopWebRtc();
     if (streaming === null) return;
     streaming = null;
     img.src = BLANK;  // ends the MJPEG request (or the snapshot loop); the server releases the stream
+  }
+
+  // The stream ended or was refused: say so and look again shortly.
+  function streamStopped() {
+    if (stopWatching) { stopWatching(); stopWatching = null; }
+    if (stopAcked) { stopAcked(); stopAcked = null; }
+    streaming = null;
+    say(`the stream from ${topic} stopped; retrying`);
+    recheckTimer = setTimeout(refreshTopics, RECHECK_MS);
   }
 
   function showStats(report) {
@@ -92,6 +107,7 @@ if (card) {
     if (playWebRtc(topic, start)) {  // WebRTC first; it calls start() again if it falls back
       if (streaming !== null) { streaming = null; img.src = BLANK; }
       if (stopWatching) { stopWatching(); stopWatching = null; }
+      if (stopAcked) { stopAcked(); stopAcked = null; }
       img.hidden = true;
       say('');
       return;
@@ -103,6 +119,22 @@ if (card) {
     streaming = url;
     say(`connecting to ${topic}…`);
     img.alt = `live image from ${topic}`;
+    if (ackedSupported()) {
+      img.dataset.transport = 'mjpeg-acked';
+      // The page's own figures; the server's report adds whether it lowered quality or size.
+      let server = null;
+      stopWatching = watchViewer(label, (report) => { server = report; });
+      stopAcked = playAcked(img, url, (figures) => {
+        say('');
+        showStats({ ...(server || { adapt: true, step: 0 }), ...figures });
+      }, (reason) => {
+        if (streaming !== url) return;
+        streamStopped();
+        say(`the stream from ${topic} stopped (${reason}); retrying`);
+      });
+      return;
+    }
+    img.dataset.transport = 'mjpeg';
     img.src = url;
     stopWatching = watchViewer(label, showStats);
   }
@@ -140,11 +172,8 @@ if (card) {
 
   img.addEventListener('load', () => { if (streaming !== null && mode === 'live') say(''); });
   img.addEventListener('error', () => {
-    if (streaming === null || mode !== 'live') return;
-    if (stopWatching) { stopWatching(); stopWatching = null; }
-    streaming = null;  // the stream ended (server restarted, topic refused): look again shortly
-    say(`the stream from ${topic} stopped; retrying`);
-    recheckTimer = setTimeout(refreshTopics, RECHECK_MS);
+    if (streaming === null || mode !== 'live' || stopAcked) return;  // the acked reader says so itself
+    streamStopped();  // the stream ended (server restarted, topic refused): look again shortly
   });
   select.addEventListener('change', () => choose(select.value));
   modeSelect.value = mode;

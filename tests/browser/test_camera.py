@@ -124,7 +124,43 @@ def test_camera_card_shows_fps_size_and_kbps_and_a_snapshot_mode_it_remembers(li
     assert page.locator("#camera-mode").input_value() == "snapshots"
     assert camera.clients() == []
     page.select_option("#camera-mode", "live")
-    page.wait_for_function("document.getElementById('camera-image').src.includes('/stream?')", timeout=15000)
+    page.wait_for_selector("#camera-image[data-transport='mjpeg-acked']", timeout=15000)
+    page.wait_for_function("document.getElementById('camera-image').src.startsWith('blob:')", timeout=15000)
+    assert len(camera.clients()) == 1
+    assert page.watch.offhost == [] and page.watch.console_errors == []
+
+
+def test_the_live_mjpeg_view_reads_the_stream_itself_and_acknowledges_what_it_received(
+        live_server, sim_process, page):
+    sim_process()
+    acks = []
+    page.on("request", lambda r: r.method == "POST" and "/api/camera/viewers/" in r.url and acks.append(r.url))
+    page.goto(live_server.url + "/")
+    page.wait_for_selector("#camera-image[data-transport='mjpeg-acked']", timeout=20000)
+    deadline = time.monotonic() + 20
+    while image_loaded(page) != 640:
+        assert time.monotonic() < deadline, page.locator("#camera-message").inner_text()
+        page.wait_for_timeout(200)
+    image = page.locator("#camera-image")
+    assert image.get_attribute("src").startswith("blob:")
+    first = image.screenshot()
+    camera = live_server.rover.feature(CameraStreams)
+
+    def acked():
+        viewers = camera.clients()
+        return viewers[0]["acked_bytes"] if len(viewers) == 1 and viewers[0]["acked"] else 0
+
+    seen = acked()
+    deadline = time.monotonic() + 20
+    while acked() <= max(seen, 100_000):  # the server counts the page's acks, and they keep coming
+        assert time.monotonic() < deadline, f"the server saw acks up to {acked()} bytes"
+        page.wait_for_timeout(200)
+    assert image.screenshot() != first  # frames keep coming
+    [viewer] = camera.clients()
+    # The size it gets follows how fast the page acknowledges (a loaded machine is a slow page).
+    assert viewer["viewer"].startswith("card-") and viewer["asked"]["width"] == 640
+    assert acks and all(url.endswith("/ack") for url in acks)
+    page.wait_for_function(f"{STATS}.test(document.getElementById('camera-stats').textContent)", timeout=15000)
     assert page.watch.offhost == [] and page.watch.console_errors == []
 
 

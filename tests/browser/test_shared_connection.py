@@ -205,7 +205,7 @@ def test_a_hidden_tab_closes_its_camera_stream_and_opens_it_again_when_shown(liv
     pages[1].evaluate(SET_HIDDEN, False)
     wait_until(lambda: viewers() == 2, 10, "the stream back in the tab shown again")
     pages[1].wait_for_function("() => { const i = document.getElementById('camera-image');"
-                               " return i.src.includes('/stream?') && i.complete && i.naturalWidth === 640; }",
+                               " return i.src.startsWith('blob:') && i.complete && i.naturalWidth === 640; }",
                                timeout=15000)
     assert context.console_errors == []
 

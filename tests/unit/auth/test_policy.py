@@ -14,6 +14,7 @@ from rover_web.auth.policy import is_loopback, required_role, role_allows, sign_
     ("GET", "/stream", "camera.stream", "viewer"),
     ("POST", "/api/estop", "estop.estop_set", "viewer"),
     ("POST", "/logout", "auth.logout", "viewer"),
+    ("POST", "/api/camera/viewers/x/ack", "camera.viewer_ack", "viewer"),
     ("GET", "/ws/teleop", "teleop_socket", "operator"),
     ("POST", "/api/teleop", "teleop.teleop_command", "operator"),
     ("POST", "/api/maps/x/goal", "livemap.post_goal", "operator"),
