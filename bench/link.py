@@ -215,11 +215,11 @@ ESTOP_TIMEOUT_S = 30.0
 ESTOP_BUDGET_S = 120.0  # the phase stops starting trials after this long (a clogged link takes ~30 s each)
 
 
-def estop_trials(url: str, n: int) -> tuple[list[float], list[float], int]:
+def estop_trials(url: str, n: int) -> tuple[list[float], list[float], int, list[tuple[float, float]]]:
     """n × (engage, then release), each POST timed; a Session keeps its connection, as a page does.
     A POST unanswered after ESTOP_TIMEOUT_S counts as that long (and is counted): the p99 is then a
-    lower bound."""
-    engage, release, timeouts = [], [], 0
+    lower bound. The last list: when each engage began and ended (to tell those a stall held)."""
+    engage, release, timeouts, spans = [], [], 0, []
     start = time.monotonic()
 
     def timed(session, engaged: bool) -> float:
@@ -237,11 +237,13 @@ def estop_trials(url: str, n: int) -> tuple[list[float], list[float], int]:
         for _ in range(n):
             if time.monotonic() - start > ESTOP_BUDGET_S:
                 break
+            t0 = time.monotonic()
             engage.append(timed(session, True))
+            spans.append((t0, time.monotonic()))
             time.sleep(0.3)
             release.append(timed(session, False))
             time.sleep(0.7)
-    return engage, release, timeouts
+    return engage, release, timeouts, spans
 
 
 def link_rtt(url: str) -> float:
@@ -326,7 +328,7 @@ def run(args) -> dict:
         twists = sub.since(mark)
         said = dict(ws.heard.counts)
         t_estop = time.monotonic()
-        engage, release, estop_timeouts = estop_trials(url, args.estops)
+        engage, release, estop_timeouts, engage_spans = estop_trials(url, args.estops)
         t_estop_end = time.monotonic()
         windows = emu.windows()
         counters = emu.counters()
@@ -357,6 +359,10 @@ def run(args) -> dict:
     ages_outside = [age for t, age, _ in frames  # issue 26's radio target is "outside outages"
                     if age is not None and not any(a <= t <= b + OUTAGE_GRACE_S for a, b in outages)]
     estop_frames = viewer.window(t_estop, t_estop_end) if viewer else []
+    # An e-stop the link itself held (a stall or an outage overlapping it) measures the link, not
+    # what stood in front of the e-stop in its queue.
+    estop_clear = [d for (t0, t1), d in zip(engage_spans, engage, strict=True)
+                   if not any(a < t1 and t0 < b for a, b, _ in windows)]
     event_ages = [age for t, age in events.ages if t_start <= t <= t_end]
     result = {
         "profile": args.profile,
@@ -379,9 +385,11 @@ def run(args) -> dict:
         "estop_rtt_p50_ms": ms(engage, 50),
         "estop_rtt_p99_ms": ms(engage, 99),
         "estop_release_p99_ms": ms(release, 99),
+        "estop_rtt_p99_outside_stalls_ms": ms(estop_clear, 99),
+        "estop_trials_outside_stalls": len(estop_clear),
         "video_fps": round(len(frames) / held_s, 2),
-        "video_kbps": round(  # MJPEG: JPEG bytes; WebRTC: RTP payload bytes
-sum(b for _, _, b in frames) * 8 / held_s / 1000, 1),
+        # MJPEG: JPEG bytes; WebRTC: RTP payload bytes
+        "video_kbps": round(sum(b for _, _, b in frames) * 8 / held_s / 1000, 1),
         "frames_unreadable": sum(1 for _, age, _ in frames if age is None),
         "frame_age_p50_ms": ms(ages, 50),
         "frame_age_p99_ms": ms(ages, 99),
@@ -423,7 +431,9 @@ def table(r: dict) -> str:
         ("e-stop POST round trip", f"p50 {f(r['estop_rtt_p50_ms'], ' ms')}, p99 {f(r['estop_rtt_p99_ms'], ' ms')}; "
                                    f"release p99 {f(r['estop_release_p99_ms'], ' ms')} ({r['estop_trials']} trials"
                                    + (f", {r['estop_timeouts']} POSTs unanswered after {ESTOP_TIMEOUT_S:g} s"
-                                      if r["estop_timeouts"] else "") + ")"),
+                                      if r["estop_timeouts"] else "") + "); "
+                                   f"p99 outside stalls and outages {f(r['estop_rtt_p99_outside_stalls_ms'], ' ms')} "
+                                   f"({r['estop_trials_outside_stalls']} trials)"),
         ("video", f"{r['video']}: {r['video_fps']} fps, {r['video_kbps']} kbit/s, "
                   f"frame age p50 {f(r['frame_age_p50_ms'], ' ms')}"
                   f", p99 {f(r['frame_age_p99_ms'], ' ms')} (outside outages "
