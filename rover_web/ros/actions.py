@@ -43,7 +43,9 @@ class GoalCanceller:
 
     def cancel_all(self, on_done: Callable[[list[dict]], None], timeout_s: float = 1.0) -> None:
         """Ask every running action server to cancel all its goals, without waiting for the answers:
-        `on_done` gets one outcome per action when all have answered or `timeout_s` has passed."""
+        `on_done` gets one outcome per action when all have answered or `timeout_s` has passed, and
+        again with every answer that comes after that (a loaded robot's server may answer late:
+        its `no_answer` then becomes what it did)."""
         outcomes: dict[str, dict] = {}
         pending: list = []
         lock = threading.Lock()
@@ -76,7 +78,11 @@ class GoalCanceller:
             with lock:
                 outcomes[name] = outcome
                 done = all(n in outcomes for n, _ in pending)
-            if done:
+                late = finished.is_set()
+                result = [outcomes[n] for n in self._clients]
+            if late:
+                on_done(result)
+            elif done:
                 finish()
 
         if not pending:

@@ -13,9 +13,10 @@ from tests.support.rospeer import stop_piped, subprocess_env
 
 
 class ActionServerPeer:
-    def __init__(self, name: str):
+    def __init__(self, name: str, cancel_delay_s: float = 0.0):
         self.proc = subprocess.Popen(
-            [sys.executable, str(ROOT / "tests" / "support" / "peers" / "action_server.py"), name],
+            [sys.executable, str(ROOT / "tests" / "support" / "peers" / "action_server.py"), name,
+             str(cancel_delay_s)],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=subprocess_env(), cwd=ROOT)
         self.events: queue.Queue = queue.Queue()
         threading.Thread(target=self._read, daemon=True).start()

@@ -45,6 +45,7 @@ REQUESTS = [
     ("POST", "/api/me/sessions/revoke", {}, "viewer", "/api/me/sessions/revoke"),  # tokens stay valid
     ("POST", "/api/camera/whep?topic=/camera/image_raw", {}, "viewer", "/api/camera/whep"),
     ("DELETE", "/api/camera/whep/nosuchsession", None, "viewer", "/api/camera/whep/<session_id>"),
+    ("POST", "/api/camera/viewers/nosuchviewer/ack", {"bytes": 0}, "viewer", "/api/camera/viewers/<viewer_id>/ack"),
     ("POST", "/logout", {}, "viewer", "/logout"),
 ]
 # Routes whose success needs a ROS peer: for a caller who may use them, this answer (from the view,
@@ -57,6 +58,8 @@ ANSWERED_WITHOUT_A_PEER = {
     # WHEP takes an SDP body (tests/integration/camera/webrtc): JSON gets this, past the role check.
     "/api/camera/whep": (415, "unsupported_media_type"),
     "/api/camera/whep/<session_id>": (404, "unknown_session"),
+    # An ack names a stream the caller opened (tests/integration/camera/test_acks.py).
+    "/api/camera/viewers/<viewer_id>/ack": (404, "unknown_viewer"),
 }
 RANK = {None: -1, "viewer": 0, "operator": 1, "admin": 2}
 PUBLIC = {("POST", "/login"), ("POST", "/login/estop")}  # tests/integration/estop/test_estop_all.py

@@ -74,11 +74,31 @@ def test_engaging_cancels_the_navigation_goal_at_once(live_server, action_server
     # machine: tests assert no speed.
     assert canceled["t"] - t0 < 1.0, canceled["t"] - t0
     assert state["engaged"]
-    outcome = wait_until(lambda: requests.get(live_server.url + "/api/estop", timeout=5).json()["cancel"],
-                         what="the cancel outcome")
+    outcome = wait_until(lambda: answered(live_server), what="the cancel outcome")
     by_action = {o["action"]: o for o in outcome}
     assert by_action["/navigate_to_pose"]["result"] == "canceled" and by_action["/navigate_to_pose"]["goals"] == 1
     assert by_action["/follow_waypoints"]["result"] == "not_running"
+
+
+def answered(server) -> list[dict] | None:
+    """The e-stop's cancel outcomes once every action has answered (a loaded machine's server may
+    answer after the 1 s `no_answer`; its answer then replaces that)."""
+    outcome = requests.get(server.url + "/api/estop", timeout=5).json()["cancel"]
+    return None if not outcome or any(o["result"] == "no_answer" for o in outcome) else outcome
+
+
+def test_a_cancel_answered_late_replaces_no_answer(live_server, action_server):
+    nav = action_server("/navigate_to_pose", cancel_delay_s=2.0)  # answers 2 s after it is asked
+    wait_until(lambda: "/navigate_to_pose" in requests.get(live_server.url + "/api/estop", timeout=5).json()[
+        "cancellable_actions"], what="the action server seen by the app")
+    nav.send_goal()
+    post(live_server, "/api/estop", {"engaged": True})
+    first = wait_until(lambda: requests.get(live_server.url + "/api/estop", timeout=5).json()["cancel"],
+                       what="the first cancel outcome")
+    assert {o["action"]: o["result"] for o in first}["/navigate_to_pose"] == "no_answer"  # 1 s passed first
+    late = {o["action"]: o for o in wait_until(lambda: answered(live_server), what="the late answer")}
+    assert (late["/navigate_to_pose"]["result"], late["/navigate_to_pose"]["goals"]) == ("canceled", 1)
+    nav.wait("canceled", timeout=5)
 
 
 def test_every_motion_request_is_refused_while_engaged_and_nothing_is_published(live_server, ros_peer):

@@ -1,12 +1,13 @@
 """A navigation-like action server in its own process: test_msgs/action/Fibonacci under any name.
 
-    python action_server.py /navigate_to_pose
+    python action_server.py /navigate_to_pose [cancel_delay_s]
 
 Goals of order 1000 and more run until canceled (one step every 50 ms); a smaller order finishes
 after that many steps, with the Fibonacci sequence so far as feedback and the whole as result.
 Lines on stdout, JSON: {"event": "ready"},
 {"event": "accepted", "t": ...}, {"event": "canceled", "t": ...} (t: CLOCK_MONOTONIC seconds).
 On stdin, "goal" sends one goal to this very server (through an ActionClient), "quit" ends.
+With cancel_delay_s, a cancel request is answered that long after it came (a busy robot's server).
 """
 
 import json
@@ -27,6 +28,7 @@ def emit(**event) -> None:
 
 def main() -> None:
     name = sys.argv[1]
+    cancel_delay_s = float(sys.argv[2]) if len(sys.argv) > 2 else 0.0
     rclpy.init()
     node = rclpy.create_node("fake_nav_server")
     group = ReentrantCallbackGroup()
@@ -60,8 +62,12 @@ def main() -> None:
         emit(event="accepted", t=time.monotonic())
         return GoalResponse.ACCEPT
 
+    def on_cancel(_handle):
+        time.sleep(cancel_delay_s)
+        return CancelResponse.ACCEPT
+
     ActionServer(node, Fibonacci, name, execute, goal_callback=on_goal,
-                 cancel_callback=lambda _handle: CancelResponse.ACCEPT, callback_group=group)
+                 cancel_callback=on_cancel, callback_group=group)
     client = ActionClient(node, Fibonacci, name, callback_group=group)
     executor = MultiThreadedExecutor(num_threads=4)
     executor.add_node(node)
