@@ -19,11 +19,9 @@ import ipaddress
 import re
 from collections.abc import Iterable, Iterator
 
-import aioice.ice
-
 _HOST_ADDRESSES: contextvars.ContextVar[tuple[str, ...] | None] = contextvars.ContextVar(
     "rover_web_webrtc_host_addresses", default=None)
-_original_get_host_addresses = aioice.ice.get_host_addresses
+_original_get_host_addresses = None
 
 
 def _get_host_addresses(use_ipv4: bool, use_ipv6: bool) -> list[str]:
@@ -33,8 +31,15 @@ def _get_host_addresses(use_ipv4: bool, use_ipv6: bool) -> list[str]:
     return [a for a in chosen if (use_ipv4 and ":" not in a) or (use_ipv6 and ":" in a)]
 
 
-if getattr(aioice.ice.get_host_addresses, "__module__", "") != __name__:
-    aioice.ice.get_host_addresses = _get_host_addresses  # see the module's docstring
+def _install() -> None:
+    """Wrap aioice's address lookup (see the module's docstring), on the first gathering: aioice
+    is imported only when a WebRTC session is first offered (service.py says why)."""
+    global _original_get_host_addresses
+    import aioice.ice
+
+    if getattr(aioice.ice.get_host_addresses, "__module__", "") != __name__:
+        _original_get_host_addresses = aioice.ice.get_host_addresses
+        aioice.ice.get_host_addresses = _get_host_addresses
 
 
 def check_addresses(addresses: Iterable[str]) -> tuple[str, ...]:
@@ -49,6 +54,7 @@ def check_addresses(addresses: Iterable[str]) -> tuple[str, ...]:
 def only_host_addresses(addresses: Iterable[str] | None) -> Iterator[None]:
     """Within this block (and tasks started in it), gather host candidates on `addresses` only;
     None or empty: every interface, as aioice does by itself."""
+    _install()
     chosen = tuple(addresses) if addresses else None
     token = _HOST_ADDRESSES.set(chosen)
     try:

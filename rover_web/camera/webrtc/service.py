@@ -25,12 +25,7 @@ import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
-from typing import Any
-
-from aiortc import RTCConfiguration, RTCIceServer, RTCPeerConnection, RTCSessionDescription
-from aiortc.rtcdtlstransport import X509_DIGEST_ALGORITHMS
-from aiortc.rtp import RTCP_PSFB_APP, RtcpPsfbPacket, unpack_remb_fci
-from aiortc.sdp import SessionDescription
+from typing import TYPE_CHECKING, Any
 
 from rover_web import process
 from rover_web.auth.policy import is_loopback
@@ -47,7 +42,12 @@ from . import frames
 from .adapt import AdaptPolicy
 from .ice import candidate_address, check_addresses, filter_candidates, only_host_addresses, parse_ice_server
 from .loop import LoopStopped, LoopThread
-from .track import CameraTrack
+
+if TYPE_CHECKING:
+    from .track import CameraTrack
+
+# aiortc, aioice and av (FFmpeg) are imported on the first offer, not at start: together about
+# 45 MB of a server's resident memory that a robot nobody watches over WebRTC does not need.
 
 log = logging.getLogger(__name__)
 
@@ -134,6 +134,9 @@ def _without_mdns(offer: str) -> str:
 def _check_fingerprints(offer: str) -> None:
     """aiortc takes an offer whose DTLS fingerprints it cannot check, then fails the handshake
     later; say so now, as a 400."""
+    from aiortc.rtcdtlstransport import X509_DIGEST_ALGORITHMS
+    from aiortc.sdp import SessionDescription
+
     for media in SessionDescription.parse(offer).media:
         if not any(f.algorithm in X509_DIGEST_ALGORITHMS for f in media.dtls.fingerprints):
             raise InvalidInput(f"the offer's {media.kind} section has no DTLS fingerprint this server can check "
@@ -142,6 +145,8 @@ def _check_fingerprints(offer: str) -> None:
 
 def tap_remb(session: WhepSession) -> None:
     """Keep each REMB estimate the browser sends for this sender, before aiortc clamps it."""
+    from aiortc.rtp import RTCP_PSFB_APP, RtcpPsfbPacket, unpack_remb_fci
+
     sender = session.sender
     handle = sender._handle_rtcp_packet  # called per RTCP packet by the DTLS transport's router
 
@@ -317,6 +322,10 @@ class WebRtcService:
         self._give_back(session)
 
     async def _negotiate(self, session: WhepSession, offer: str) -> str:
+        from aiortc import RTCConfiguration, RTCIceServer, RTCPeerConnection, RTCSessionDescription
+
+        from .track import CameraTrack
+
         config = RTCConfiguration(iceServers=[RTCIceServer(**s) for s in self.ice_servers])  # [] : no STUN
         with only_host_addresses(self.host_addresses):
             pc = RTCPeerConnection(config)
