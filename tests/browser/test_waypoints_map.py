@@ -120,7 +120,8 @@ def on_map(page) -> dict:
     loaded machine) moves the whole map down the page, and must not look like the robot moving."""
     marker = page.locator(".wp-robot").bounding_box()
     box = page.locator("#wp-map").bounding_box()
-    return {"x": marker["x"] - box["x"], "y": marker["y"] - box["y"]}
+    # The marker's centre (MapLibre anchors it there): its box's corner moves when it changes size.
+    return {"x": marker["x"] + marker["width"] / 2 - box["x"], "y": marker["y"] + marker["height"] / 2 - box["y"]}
 
 
 def test_the_simulated_robot_moves_on_the_map(live_server, sim_process, ros_peer, page):
