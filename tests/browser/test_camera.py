@@ -22,14 +22,19 @@ def image_loaded(page):
                          " return i.complete && i.naturalWidth; }")
 
 
-def test_camera_panel_shows_moving_frames_from_the_simulator(live_server, sim_process, page):
-    sim_process()
-    page.goto(live_server.url + "/")
-    page.wait_for_selector("#link-server[data-state='live']", timeout=10000)
+def wait_full_size(page):
+    """Until the card shows a 640-wide frame (20 s), or fails with the card's message."""
     deadline = time.monotonic() + 20
     while image_loaded(page) != 640:
         assert time.monotonic() < deadline, page.locator("#camera-message").inner_text()
         page.wait_for_timeout(200)
+
+
+def test_camera_panel_shows_moving_frames_from_the_simulator(live_server, sim_process, page):
+    sim_process()
+    page.goto(live_server.url + "/")
+    page.wait_for_selector("#link-server[data-state='live']", timeout=10000)
+    wait_full_size(page)
     assert page.locator("#camera-topic").input_value() == "/camera/image_raw"
     image = page.locator("#camera-image")
     first = image.screenshot()
@@ -137,10 +142,7 @@ def test_the_live_mjpeg_view_reads_the_stream_itself_and_acknowledges_what_it_re
     page.on("request", lambda r: r.method == "POST" and "/api/camera/viewers/" in r.url and acks.append(r.url))
     page.goto(live_server.url + "/")
     page.wait_for_selector("#camera-image[data-transport='mjpeg-acked']", timeout=20000)
-    deadline = time.monotonic() + 20
-    while image_loaded(page) != 640:
-        assert time.monotonic() < deadline, page.locator("#camera-message").inner_text()
-        page.wait_for_timeout(200)
+    wait_full_size(page)
     image = page.locator("#camera-image")
     assert image.get_attribute("src").startswith("blob:")
     first = image.screenshot()
