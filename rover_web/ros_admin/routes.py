@@ -58,7 +58,7 @@ def check_mode():
 
 def _is_admin() -> bool:
     """Whether this request may write (the admin role; anyone with sign-in off, as for every route)."""
-    return may("admin", current_feature(AuthService).required)
+    return may("admin", current_feature(AuthService).sign_in_on())
 
 
 def _write_block() -> str | None:
@@ -99,7 +99,7 @@ def ros_page():
                for n in nodes for a in n["action_servers"]]
     return render_template("ros.html", off=False, nodes=nodes, services=services, actions=actions,
                            goals=[g.snapshot() for g in admin.goals.all()], write_block=_write_block(),
-                           can_cancel=may("operator", current_feature(AuthService).required))
+                           can_cancel=may("operator", current_feature(AuthService).sign_in_on()))
 
 
 @bp.get("/api/nodes")

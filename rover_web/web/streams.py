@@ -22,7 +22,7 @@ def sign_in_on() -> bool:
     from rover_web.auth.service import AuthService  # here: web/ is below the features it serves
 
     try:
-        return current_rover().feature(AuthService).required
+        return current_rover().feature(AuthService).sign_in_on()
     except Exception:  # an app built without the auth feature (some tests): nobody signs in
         return False
 

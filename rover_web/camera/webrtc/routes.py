@@ -35,7 +35,7 @@ def whep_offer():
         raise ApiError(415, "unsupported_media_type",
                        "send the SDP offer as the body with the header Content-Type: application/sdp (WHEP)")
     service = current_feature(WebRtcService)
-    sign_in = current_feature(AuthService).required
+    sign_in = current_feature(AuthService).sign_in_on()
     identity = current_identity()
     session_id, answer = service.open(request.args, request.get_data(as_text=True), user=signed_in_name(),
                                       role=getattr(identity, "role", None), may_operate=may("operator", sign_in))
@@ -51,7 +51,7 @@ def whep_offer():
 @bp.delete("/api/camera/whep/<session_id>")
 def whep_end(session_id: str):
     service = current_feature(WebRtcService)
-    sign_in = current_feature(AuthService).required
+    sign_in = current_feature(AuthService).sign_in_on()
     ended = service.end(session_id[:64], signed_in_name() if sign_in else None, admin=may("admin", sign_in))
     if not ended:
         raise ApiError(404, "unknown_session", "no such WebRTC session (it ended, or was never made)")

@@ -213,3 +213,15 @@ def test_sign_out_everywhere_with_sign_in_off_is_a_409(client):
     answer = client.post("/api/me/sessions/revoke", json={})
     assert answer.status_code == 409 and answer.get_json()["error"] == "sign_in_off"
 
+
+
+def test_under_auto_a_proxied_operator_is_told_ros_writes_are_admin_work(loopback_app_with_users):
+    """The pages decide what to offer from the request's own sign-in rule, not the server's: under
+    `auto` a proxied request must sign in, so an operator there is an operator, not everyone."""
+    client = loopback_app_with_users.test_client()
+    proxied = {"X-Forwarded-For": "203.0.113.7"}
+    assert sign_in(client, "operator").status_code == 303
+    page = client.get("/ros", headers=proxied).get_data(as_text=True)
+    assert "needs the admin role" in page and 'data-can-cancel="yes"' in page
+    local = client.get("/ros").get_data(as_text=True)  # made on this machine: sign-in off, anyone may
+    assert "needs the admin role" not in local

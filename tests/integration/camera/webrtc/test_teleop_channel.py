@@ -168,6 +168,20 @@ def test_the_teleop_channel_needs_the_operator_role(signed_server, camera, stick
     wait_until(lambda: len(client.client.frames) > 3, 20, "a viewer still gets the video")
 
 
+def test_under_auto_a_proxied_viewer_gets_no_teleop_channel(webrtc_server, camera, stick, tmp_path):
+    """Sign-in off on loopback under `auto` is a rule for requests made on this machine: a viewer
+    whose offer came through a proxy signed in, and its session must not drive."""
+    from tests.support.auth import add_users
+
+    db_path = tmp_path / "auto.sqlite3"
+    tokens = add_users(db_path)
+    server = webrtc_server(ROVER_WEB_AUTH="auto", ROVER_WEB_DB_PATH=str(db_path))
+    camera("/cam", width=160, height=120, hz=15)
+    client = stick(server, "datachannel", headers={"Authorization": f"Bearer {tokens['viewer']}",
+                                                   "X-Forwarded-For": "203.0.113.7"})
+    assert client.hello["type"] == "error" and client.hello["error"] == "forbidden"
+
+
 def test_a_revoked_token_ends_the_peer_connection_and_stops_the_robot(signed_server, ros_peer, camera):
     """Issue 27: a revocation reaches the WebRTC session made with the token, and its teleop channel
     stops the robot first, as it does for the teleop WebSocket."""
