@@ -190,7 +190,8 @@ def test_estop_reaches_the_server_within_a_second_with_eight_tabs_open(live_serv
                        10, "the e-stop engaged")
     took = state["since"] - pages[-1].evaluate("window.clickedAt")
     assert took < 1.0, f"the e-stop reached the server {took:.2f} s after the click"
-    pages[-1].wait_for_selector("#estop[data-engaged='yes'][data-unconfirmed='no']", timeout=5000)
+    # The page confirms from the server's reply; eight tabs decoding MJPEG on two busy cores make it slow.
+    pages[-1].wait_for_selector("#estop[data-engaged='yes'][data-unconfirmed='no']", timeout=15000)
 
 
 def test_a_hidden_tab_closes_its_camera_stream_and_opens_it_again_when_shown(live_server, sim_process, context):

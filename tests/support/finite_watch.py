@@ -27,7 +27,10 @@ class FiniteWatch:
 
     def _read(self) -> None:
         for line in self.proc.stdout:
-            event = json.loads(line)
+            try:
+                event = json.loads(line)
+            except ValueError:
+                continue  # Fast DDS's own diagnostics share the peer's stdout
             with self._changed:
                 if event["event"] == "watching":
                     self.topics = event["topics"]
