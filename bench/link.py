@@ -77,7 +77,9 @@ def value_index(linear: float) -> int | None:
 
 class Stick(threading.Thread):
     """The operator's thumb on the stick: a frame every 1/STICK_HZ s, each a new value, with the
-    epoch the server last said (a deadman stop starts a new one)."""
+    epoch the server last said (a deadman stop starts a new one), and `seq` and `t` as the Drive
+    card sends them: the server's hold, ramp and link figures go by those, so frames without them
+    would measure another rule than the page gets."""
 
     def __init__(self, ws, send=None):
         super().__init__(daemon=True)
@@ -93,8 +95,9 @@ class Stick(threading.Thread):
         while self.running.is_set():
             while (wait := start + i * period - time.monotonic()) > 0:
                 time.sleep(wait)
-            text = frame(stick_value(i), epoch=self.ws.heard.epoch)
             t = time.monotonic()
+            # t counts from the stick's start, as performance.now() counts from the page's
+            text = frame(stick_value(i), epoch=self.ws.heard.epoch, seq=i + 1, t_ms=(t - start) * 1000)
             try:
                 self._send(text)
             except OSError:
