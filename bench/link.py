@@ -2,6 +2,7 @@
 
     .venv/bin/python bench/link.py --profile wifi-edge --camera on [--video mjpeg|webrtc] [--adapt on|off]
                                    [--teleop websocket|datachannel] [--seconds 60] [--estops 10] [--seed 1]
+                                   [--rate-kbps N --delay-ms N ...: the profile's figures, as the emulator's CLI]
 
 Starts the demo's simulator (`python -m rover_web.sim`: rover, buoy, drone, camera 640×480 at
 30 Hz) and the app (`flask run`, bench/common.Server) in their own processes, and a LinkEmulator
@@ -17,6 +18,9 @@ the emulator only; the rclpy subscriber watching /cmd_vel is on the robot's side
    - spurious_stops_per_min: zero Twists following a non-zero one while the stick is held, per
      minute held, leaving out those from an outage's start to 1 s after its end (an outage must
      stop the robot).
+   - outage_zero_ms: for each outage that begins in the hold, its start (the emulator's schedule)
+     → the first zero Twist at the subscriber; nothing the operator sends arrives in an outage, so
+     this must be within the app's deadman bound (deadman_max_ms) plus a repeater period.
    - video_fps, frame_age_p50/p99_ms: frames received per second; age = the frame's last byte
      in this process (wall clock) − the time code the simulated camera drew into it (its wall
      clock at capture, rover_web/sim/timecode.py, read from the decoded JPEG): glass to glass.
@@ -36,9 +40,9 @@ median of 10 GET /api/estop on the idle link before the hold phase (a small requ
 from __future__ import annotations
 
 import argparse
-import bisect
 import io
 import json
+import math
 import os
 import statistics
 import subprocess
@@ -51,28 +55,27 @@ import requests
 from common import ROOT, WALL_MINUS_MONOTONIC, Server, SseFleet, machine, percentile, ros_env, stop_process, wait_for
 
 sys.path.insert(0, str(ROOT))
+from link_figures import (  # noqa: E402
+    OUTAGE_GRACE_S,
+    VALUES,
+    deadman_bound_s,
+    first_outage_in,
+    outage_zeros,
+    spurious_stops,
+    stick_value,
+    teleop_latencies,
+)
 from link_webrtc import ChannelSocket, LinkWhep  # noqa: E402
 from teleop import Heard, Subscriber, connect, encoded, frame, hang_up  # noqa: E402
 
 from rover_web import config as config_module  # noqa: E402
 from rover_web.linkemu import PROFILES, LinkEmulator, profile  # noqa: E402
+from rover_web.linkemu.profiles import CUSTOM_FIELDS  # noqa: E402
 from rover_web.sim import timecode  # noqa: E402
 from tests.support.mjpeg import MjpegClient  # noqa: E402
 
 TOPIC = "/camera/image_raw"
 STICK_HZ = 25.0
-VALUES = 500  # distinct stick values, then they repeat (20 s at 25 Hz)
-MAX_LINEAR = 5.0  # ROVER_WEB_MAX_LINEAR_MPS's default: the Twist is the stick's fraction of it
-OUTAGE_GRACE_S = 1.0  # stops up to this long after an outage are the outage's
-
-
-def stick_value(i: int) -> float:
-    return round(0.3 + (i % VALUES + 1) / 2000, 6)
-
-
-def value_index(linear: float) -> int | None:
-    k = round((linear / MAX_LINEAR - 0.3) * 2000) - 1
-    return k if 0 <= k < VALUES else None
 
 
 class Stick(threading.Thread):
@@ -114,38 +117,6 @@ class Stick(threading.Thread):
                 self._send(json.dumps({"stop": True}))
             except OSError:
                 self.lost_at = time.monotonic()
-
-
-def teleop_latencies(sent: list[tuple[float, int]], twists: list[tuple[float, float, float]]) -> list[float]:
-    """Each frame's latency: its send → the first Twist with its value before that value is sent again."""
-    arrivals: dict[int, list[float]] = {}
-    for t, lin, _ in twists:
-        if (k := value_index(lin)) is not None:
-            arrivals.setdefault(k, []).append(t)
-    out = []
-    next_send: dict[int, float] = {}
-    for t_sent, k in reversed(sent):
-        times = arrivals.get(k, [])
-        j = bisect.bisect_left(times, t_sent)
-        if j < len(times) and times[j] < next_send.get(k, float("inf")):
-            out.append(times[j] - t_sent)
-        next_send[k] = t_sent
-    return out
-
-
-def spurious_stops(twists, start: float, end: float, outages: list[tuple[float, float]]) -> tuple[int, int]:
-    """(stops outside outages, stops inside them): zero Twists after a non-zero one within [start, end]."""
-    outside = inside = 0
-    moving = False
-    for t, lin, ang in twists:
-        zero = lin == 0.0 and ang == 0.0
-        if zero and moving and start <= t <= end:
-            if any(a <= t <= b + OUTAGE_GRACE_S for a, b in outages):
-                inside += 1
-            else:
-                outside += 1
-        moving = not zero
-    return outside, inside
 
 
 class Viewer:
@@ -270,15 +241,17 @@ def adapt_setting(adapt: str | None) -> tuple[dict[str, str], str]:
     return {"ROVER_WEB_CAMERA_ADAPT": "true" if adapt == "on" else "false"}, adapt
 
 
-def bench_profile(name: str):
-    """A named profile, or `loopback`: no limits at all, what the machine alone costs (a control)."""
+def bench_profile(name: str, overrides: dict):
+    """A named profile, or `loopback`: no limits at all, what the machine alone costs (a control);
+    either with the link flags given (as `flask link-emulator` takes them; `custom` is made of them)."""
     if name == "loopback":
-        return profile("custom", rate_kbps=1_000_000, delay_ms=0, buffer_kb=4096)
-    return profile(name)
+        return profile("custom", **{"rate_kbps": 1_000_000, "delay_ms": 0, "buffer_kb": 4096,
+                                    **{k: v for k, v in overrides.items() if v is not None}})
+    return profile(name, **overrides)
 
 
 def run(args) -> dict:
-    link = bench_profile(args.profile)
+    link = bench_profile(args.profile, {k: getattr(args, k) for k in CUSTOM_FIELDS})
     load_before = os.getloadavg()[0]
     scratch = tempfile.TemporaryDirectory(prefix="rover_web-bench-link-")
     extra, adapt = adapt_setting(args.adapt)
@@ -298,6 +271,7 @@ def run(args) -> dict:
         # The UDP relay's target is the server's ICE port, known only from the WHEP answer: LinkWhep
         # sets it before the first datagram (port 9, discard, until then).
         udp = {"udp_listen": "127.0.0.1:0", "udp_target": ("127.0.0.1", 9)} if webrtc else {}
+        t_emulator = time.monotonic()
         emu = LinkEmulator(link, "127.0.0.1:0", ("127.0.0.1", server.port), seed=args.seed, **udp).start()
         url = f"http://127.0.0.1:{emu.port}"
         measured_rtt = link_rtt(url)
@@ -321,6 +295,11 @@ def run(args) -> dict:
         stick.start()
         time.sleep(2.0)  # settle: the first frames, the video's queue filling
         t_start = time.monotonic()
+        if link.outage_every_s and link.outage_s and \
+                first_outage_in(link, t_emulator, t_start, t_start + args.seconds) is None:
+            print(f"# the hold ends before the link's first outage ({link.outage_every_s / 2:g} s after the "
+                  f"emulator started): outage_zero_ms will be empty; give --seconds "
+                  f"{math.ceil(t_emulator + link.outage_every_s / 2 + link.outage_s - t_start)} or more", flush=True)
         time.sleep(args.seconds)
         t_end = time.monotonic()
         if webrtc:  # what the server's adaptation chose by the end of the hold (asked on loopback, not the link)
@@ -333,6 +312,8 @@ def run(args) -> dict:
         t_estop = time.monotonic()
         engage, release, estop_timeouts, engage_spans = estop_trials(url, args.estops)
         t_estop_end = time.monotonic()
+        # the deadman's zero for an outage near the hold's end comes after the release
+        twists_after = sub.since(mark)
         windows = emu.windows()
         counters = emu.counters()
         route = viewer.route() if webrtc else None
@@ -357,6 +338,7 @@ def run(args) -> dict:
     latencies = [x * 1000 for x in teleop_latencies([s for s in stick.sent if t_start <= s[0] <= t_end],
                                                     twists)]
     stops_out, stops_in = spurious_stops(twists, t_start, t_end, outages)
+    zeros, moves = outage_zeros(twists_after, t_start, t_end, outages)
     frames = viewer.window(t_start, t_end) if viewer else []
     ages = [age for _, age, _ in frames if age is not None]
     ages_outside = [age for t, age, _ in frames  # issue 26's radio target is "outside outages"
@@ -374,6 +356,7 @@ def run(args) -> dict:
         "adapt": adapt,
         "teleop": args.teleop,
         "seconds": round(held_s, 1),
+        "link": link.describe(),
         "link_rtt_ms": link.rtt_ms,
         "link_rtt_measured_ms": round(measured_rtt, 1),
         "teleop_p50_ms": ms(latencies, 50),
@@ -381,6 +364,11 @@ def run(args) -> dict:
         "teleop_frames_matched": f"{len(latencies)}/{sum(1 for s in stick.sent if t_start <= s[0] <= t_end)}",
         "spurious_stops_per_min": round(stops_out / (held_s / 60), 2),
         "stops_in_outages": stops_in,
+        # each outage begun while the stick was held: its start → the first zero Twist on /cmd_vel
+        "outage_zero_ms": zeros,
+        "outage_zero_max_ms": max(zeros, key=lambda z: math.inf if z is None else z) if zeros else None,
+        "outage_moves_after_zero": sum(moves),  # non-zero Twists after that zero, before the outage ended
+        "deadman_max_ms": round(deadman_bound_s(env, config_module.SETTINGS) * 1000),
         "server_said": said,
         "teleop_socket_lost_at_s": None if stick.lost_at is None else round(stick.lost_at - t_start, 1),
         "estop_trials": len(engage),
@@ -431,6 +419,9 @@ def table(r: dict) -> str:
                            f"during outages); server said {r['server_said'] or 'nothing'}"
                            + ("" if r["teleop_socket_lost_at_s"] is None
                               else f"; the teleop socket was lost {r['teleop_socket_lost_at_s']} s into the hold")),
+        ("outage → zero /cmd_vel", ", ".join(f(z, " ms") for z in r["outage_zero_ms"])
+         + f" (bound {r['deadman_max_ms']} ms); {r['outage_moves_after_zero']} non-zero Twists after it in the "
+           f"outage" if r["outage_zero_ms"] else "no outage began in the hold"),
         ("e-stop POST round trip", f"p50 {f(r['estop_rtt_p50_ms'], ' ms')}, p99 {f(r['estop_rtt_p99_ms'], ' ms')}; "
                                    f"release p99 {f(r['estop_release_p99_ms'], ' ms')} ({r['estop_trials']} trials"
                                    + (f", {r['estop_timeouts']} POSTs unanswered after {ESTOP_TIMEOUT_S:g} s"
@@ -450,7 +441,7 @@ def table(r: dict) -> str:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--profile", choices=[*PROFILES, "loopback"], default="wifi-edge",
+    parser.add_argument("--profile", choices=[*PROFILES, "custom", "loopback"], default="wifi-edge",
                         help="the link; loopback: the emulator with no limits, a control for the machine's own noise")
     parser.add_argument("--camera", choices=("on", "off"), default="on")
     parser.add_argument("--video", choices=("mjpeg", "webrtc"), default="mjpeg")
@@ -462,9 +453,20 @@ def main() -> int:
     parser.add_argument("--seconds", type=float, default=60.0, help="how long the stick is held")
     parser.add_argument("--estops", type=int, default=10, help="e-stop engage/release trials after the hold")
     parser.add_argument("--seed", type=int, default=1, help="the emulator's random seed (stalls, jitter)")
+    flags = parser.add_argument_group("the link", "override the profile's figures, as `flask link-emulator` "
+                                      "does; --profile custom starts from a plain 10 Mbit/s link")
+    for name in CUSTOM_FIELDS:
+        if name == "reset_on_outage":
+            flags.add_argument("--reset-on-outage", action="store_true", default=None)
+        else:
+            flags.add_argument("--" + name.replace("_", "-"), type=float, metavar="N")
     args = parser.parse_args()
     if args.teleop == "datachannel" and (args.video != "webrtc" or args.camera != "on"):
         parser.error("--teleop datachannel needs --video webrtc --camera on (the channel is the WHEP session's)")
+    try:
+        bench_profile(args.profile, {k: getattr(args, k) for k in CUSTOM_FIELDS})
+    except (ValueError, TypeError) as exc:
+        parser.error(str(exc))
     result = run(args)
     print(table(result), flush=True)
     print(json.dumps(result), flush=True)
