@@ -26,7 +26,19 @@ RECORD = """async () => {
     live.on(ch, (data, ev) => window.seen.push({ ch, id: Number(ev.lastEventId),
       linear: ch === 'odom' ? data.linear : null, link: document.body.dataset.link }));
   }
+  // What a person sees, in order: the speed's text and the page's link state as each changes.
+  window.shown = [];
+  const speed = document.getElementById('odom-linear');
+  const note = (what, value) => window.shown.push({ what, value, t: performance.now() });
+  new MutationObserver(() => note('speed', speed.textContent))
+    .observe(speed, { childList: true, characterData: true, subtree: true });
+  new MutationObserver(() => note('link', document.body.dataset.link))
+    .observe(document.body, { attributes: true, attributeFilter: ['data-link'] });
 }"""
+
+# Published one by one while the page cannot hear: queued in the old stream, never current.
+HELD_VALUES = (0.31, 0.32, 0.33, 0.34, 0.35, 0.36)
+CURRENT = 0.75
 
 STALE_MARK = """(id) => {
   const el = document.getElementById(id);
@@ -71,25 +83,44 @@ def test_a_stalled_link_marks_the_page_down_and_recovery_shows_current_values_wi
     assert page.evaluate("Number(getComputedStyle(document.getElementById('estop-engage')).opacity)") == 1
     seen_before_resume = len(page.evaluate("window.seen"))
 
-    # A new value, published by the robot's side while the page cannot hear it.
-    peer.publish("/odom", odom(0.75))
-    wait_until(lambda: (server.rover.hub.latest("odom") or {}).get("linear") == 0.75, 10, "the server has 0.75")
+    # The robot's side goes on while the page cannot hear: a run of values, each one published to
+    # the hub (odom is throttled to 10 Hz, so waiting for each keeps any from being conflated), so
+    # the stream the page had open has every one of them queued in its socket, then the current one.
+    for value in (*HELD_VALUES, CURRENT):
+        peer.publish("/odom", odom(value))
+        wait_until(lambda v=value: (server.rover.hub.latest("odom") or {}).get("linear") == v, 10,
+                   f"the server has {value}")
     # Still down: nothing reached the page, and what it shows is still marked.
     assert page.locator("body").get_attribute("data-link") == "down"
     assert page.locator("#odom-linear").inner_text() == "0.25"
+    shown_before_resume = len(page.evaluate("window.shown"))
 
     proxy.resume()
     page.wait_for_selector("body[data-link='up']", timeout=20000)
-    page.wait_for_function("document.getElementById('odom-linear').textContent === '0.75'", timeout=10000)
+    page.wait_for_function(f"document.getElementById('odom-linear').textContent === '{CURRENT:.2f}'",
+                           timeout=10000)
+    # The held bytes of the old stream are flushed the moment the link resumes: give any that the
+    # page would show time to show.
+    page.wait_for_timeout(1500)
     after = page.evaluate(STALE_MARK, "odom-linear")
     assert after["tag"] == "none" and after["opacity"] == 1.0, after
     assert page.locator("#estop-link").is_hidden()
 
     seen = page.evaluate("window.seen")
-    after_resume = seen[seen_before_resume:]
-    assert [e for e in after_resume if e["ch"] == "odom"], "no odom event after the outage"
-    # Nothing from before the outage came back: after it, odom only ever carried the new value...
-    assert {e["linear"] for e in after_resume if e["ch"] == "odom"} == {0.75}
+    after_resume = [e["linear"] for e in seen[seen_before_resume:] if e["ch"] == "odom"]
+    # The first odom the page heard after the outage was the current value (the new stream's
+    # snapshot), and nothing older came after it: neither the value from before the outage nor any
+    # of those queued during it.
+    assert after_resume and after_resume[0] == CURRENT, after_resume
+    assert set(after_resume) == {CURRENT}, after_resume
+    # What the page showed: once the link was up again, the speed went straight to the current
+    # value, within a moment (the snapshot came with the first bytes), and never showed another.
+    shown = page.evaluate("window.shown")[shown_before_resume:]
+    up = next(i for i, e in enumerate(shown) if e["what"] == "link" and e["value"] == "up")
+    speeds = [e for e in shown[up:] if e["what"] == "speed"]
+    assert speeds and {e["value"] for e in speeds} == {f"{CURRENT:.2f}"}, shown  # (a repeated snapshot rewrites it)
+    assert speeds[0]["t"] - shown[up]["t"] < 2000, shown
+    assert not [e for e in shown[:up] if e["what"] == "speed"], shown  # nothing while down either
     # ...and no event was handed to the page twice or after a newer one, on either channel.
     for ch in ("odom", "status"):
         ids = [e["id"] for e in seen if e["ch"] == ch]
