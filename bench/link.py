@@ -59,6 +59,7 @@ from link_figures import (  # noqa: E402
     OUTAGE_GRACE_S,
     VALUES,
     deadman_bound_s,
+    down_since,
     first_outage_in,
     outage_zeros,
     spurious_stops,
@@ -339,6 +340,7 @@ def run(args) -> dict:
                                                     twists)]
     stops_out, stops_in = spurious_stops(twists, t_start, t_end, outages)
     zeros, moves = outage_zeros(twists_after, t_start, t_end, outages)
+    lead_ms = [round((a - down_since(a, windows)) * 1000, 1) for a, _ in outages if t_start <= a <= t_end]
     frames = viewer.window(t_start, t_end) if viewer else []
     ages = [age for _, age, _ in frames if age is not None]
     ages_outside = [age for t, age, _ in frames  # issue 26's radio target is "outside outages"
@@ -368,6 +370,7 @@ def run(args) -> dict:
         "outage_zero_ms": zeros,
         "outage_zero_max_ms": max(zeros, key=lambda z: math.inf if z is None else z) if zeros else None,
         "outage_moves_after_zero": sum(moves),  # non-zero Twists after that zero, before the outage ended
+        "outage_down_before_ms": lead_ms,  # how long a stall ran into each outage: the link was down that much earlier
         "deadman_max_ms": round(deadman_bound_s(env, config_module.SETTINGS) * 1000),
         "server_said": said,
         "teleop_socket_lost_at_s": None if stick.lost_at is None else round(stick.lost_at - t_start, 1),
@@ -420,8 +423,10 @@ def table(r: dict) -> str:
                            + ("" if r["teleop_socket_lost_at_s"] is None
                               else f"; the teleop socket was lost {r['teleop_socket_lost_at_s']} s into the hold")),
         ("outage → zero /cmd_vel", ", ".join(f(z, " ms") for z in r["outage_zero_ms"])
-         + f" (bound {r['deadman_max_ms']} ms); {r['outage_moves_after_zero']} non-zero Twists after it in the "
-           f"outage" if r["outage_zero_ms"] else "no outage began in the hold"),
+         + f" (bound {r['deadman_max_ms']} ms; the link was down (a stall) "
+           + ", ".join(f"{d:g}" for d in r["outage_down_before_ms"]) + " ms before it); "
+           f"{r['outage_moves_after_zero']} non-zero Twists after it in the outage"
+         if r["outage_zero_ms"] else "no outage began in the hold"),
         ("e-stop POST round trip", f"p50 {f(r['estop_rtt_p50_ms'], ' ms')}, p99 {f(r['estop_rtt_p99_ms'], ' ms')}; "
                                    f"release p99 {f(r['estop_release_p99_ms'], ' ms')} ({r['estop_trials']} trials"
                                    + (f", {r['estop_timeouts']} POSTs unanswered after {ESTOP_TIMEOUT_S:g} s"

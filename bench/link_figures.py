@@ -81,6 +81,19 @@ def outage_zeros(twists, start: float, end: float,
     return zeros, moves
 
 
+def down_since(t: float, windows: list[tuple[float, float, str]]) -> float:
+    """When the link went down for good before t: a stall that ran into the outage (back to back
+    or overlapping) already kept the operator's frames from arriving, so the deadman's clock may
+    have started there, before the outage did."""
+    begin, changed = t, True
+    while changed:
+        changed = False
+        for a, b, _ in windows:
+            if a < begin <= b:
+                begin, changed = a, True
+    return begin
+
+
 def deadman_bound_s(env: dict, settings) -> float:
     """The app's hard bound as this run's environment sets it (a bound below the hold is the hold)."""
     def value(name: str) -> float:
