@@ -67,7 +67,10 @@ def test_boxes_fill_in_order_and_reset_on_black(live_server, ros_peer, page):
     assert page.watch.console_errors == [] and page.watch.offhost == []
 
 
-def test_markup_in_a_colour_string_is_shown_as_text(live_server, ros_peer, page):
+def test_markup_in_a_colour_string_is_shown_as_text(live_server_factory, ros_peer, page):
+    # The first box is filled before the page opens: a load that takes longer than the light's
+    # 3 s staleness (a busy machine) would start a new cycle and lose it.
+    live_server = live_server_factory(ROVER_WEB_LIGHT_STALE_AFTER_S=60.0)
     peer = light_publisher(ros_peer, live_server.rover)
     peer.publish(LIGHTS, {"data": MARKUP})
     deadline = time.monotonic() + 10
