@@ -65,6 +65,10 @@ SETTINGS: tuple[Setting, ...] = (
             "Host header values accepted (port ignored; '.example.org' matches subdomains); guards DNS rebinding"),
     Setting("ALLOWED_ORIGINS", [], "list",
             "extra Origins (scheme://host:port) allowed to change state, besides the page's own origin"),
+    Setting("PROXY_HOPS", 0, "int",
+            "reverse proxies in front of the app whose X-Forwarded-For, -Proto and -Host are believed (Werkzeug's "
+            "ProxyFix), so each client keeps its own address; 0: none (a client could forge them); set it only "
+            "when nothing but the proxy can reach the app", 0, 10),
     # --- sign-in and HTTPS ---
     Setting("AUTH", "auto", "str",
             "sign-in: auto (required unless the server listens on loopback only), required, or off",

@@ -120,12 +120,20 @@ def tokens_revoke(token_id: int) -> None:
 @click.option("--host", "hosts", multiple=True, help="a name or address browsers will use (repeatable)")
 @click.option("--dir", "directory", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="where to write cert.pem and key.pem (default: the instance folder's tls/)")
-def tls_self_signed(hosts: tuple[str, ...], directory: Path | None) -> None:
-    """Write a self-signed certificate and key into the instance folder."""
-    from .tls import default_hosts, write_self_signed  # cryptography: ~10 MB a server never needs
+@click.option("--new-ca", is_flag=True,
+              help="make a new CA even if one is there: every device must then trust the new ca.pem")
+def tls_self_signed(hosts: tuple[str, ...], directory: Path | None, new_ca: bool) -> None:
+    """Write a self-signed certificate and key into the instance folder, signed by the CA made
+    there before (devices that trust it, and noted HSTS, keep working), or a new one."""
+    from .tls import NewCANeeded, default_hosts, write_self_signed  # cryptography: ~10 MB a server never needs
 
     directory = directory or Path(current_app.instance_path) / "tls"
-    cert, key = write_self_signed(directory, list(hosts) or default_hosts())
+    try:
+        cert, key = write_self_signed(directory, list(hosts) or default_hosts(), new_ca=new_ca)
+    except NewCANeeded as exc:
+        raise click.ClickException(f"{exc}. Nothing was written. Run again with --new-ca to make a new CA; "
+                                   "devices that trusted the old ca.pem must then trust the new one, and "
+                                   "until they do, HTTPS (and HSTS) keeps them out of the GUI") from None
     click.echo(f"wrote {cert} and {key}; trust {directory / 'ca.pem'} on the devices that browse to it")
     click.echo(f"use them with:\n  export ROVER_WEB_TLS_CERT={cert} ROVER_WEB_TLS_KEY={key}")
 

@@ -7,7 +7,7 @@ USER = obj({"name": {"type": "string"}, "role": ROLE}, closed=False)
 LOSES = "could take the fuzz's own access away; its own user and token are kept out of reach too"
 OFF = {403: "sign_in_off (sign-in is off: manage users and tokens with `flask --app rover_web users ...`)"}
 ACCOUNT_400 = ("missing_body, bad_json, non_finite, unknown_field, missing_field, bad_type, too_long, "
-               "bad_name, bad_role, weak_password")
+               "bad_name, bad_role, bad_password")
 
 PATHS = {
     "/login": {
@@ -54,13 +54,13 @@ PATHS = {
     "/api/users/{name}": {
         "patch": op("Change a user's role or password", tag="auth", role="admin", ok=USER,
                     body=obj({"role": ROLE, "password": {"type": "string", "maxLength": 1024}}, minProperties=1),
-                    errors={400: ACCOUNT_400 + ", last_admin", 404: "no_such_user", **OFF}, fuzz="last",
+                    errors={400: ACCOUNT_400, 404: "no_such_user", **OFF}, fuzz="last",
                     fuzz_why=LOSES,
                     description="The user's session epoch is renewed: their sessions end, and their open streams "
                                 "and sockets close (an admin changing their own password gets a new session)."),
         "delete": op("Remove a user and their tokens", tag="auth", role="admin",
                      ok=obj({"removed": {"type": "string"}}),
-                     errors={400: "last_admin", 404: "no_such_user", **OFF}, fuzz="last", fuzz_why=LOSES,
+                     errors={404: "no_such_user", **OFF}, fuzz="last", fuzz_why=LOSES,
                      description="Their sessions end and their open streams and sockets close."),
     },
     "/api/tokens": {

@@ -35,6 +35,7 @@ class AuthService:
         self.listen_hosts = listen_hosts
         self.trusted_hosts = list(trusted_hosts)
         self.required = sign_in_required(mode, listen_hosts)
+        self.proxy_hops = (config or {}).get("ROVER_WEB_PROXY_HOPS", 0)
 
     def start(self, rover) -> None:
         """The backstop: changes made in another process (the CLI) reach open streams within a
@@ -71,6 +72,11 @@ class AuthService:
         """Refuse to serve a network with sign-in required and nobody able to sign in."""
         if mode_note := self.startup_note():
             log.warning(mode_note)
+        if self.proxy_hops and not (self.listen_hosts and all(is_loopback(h) for h in self.listen_hosts)):
+            # A client that reaches the app around the proxy writes X-Forwarded-For itself.
+            log.warning("ROVER_WEB_PROXY_HOPS=%d believes X-Forwarded-For from any client, and this server "
+                        "may be reachable by others directly: listen on 127.0.0.1 behind the proxy, or "
+                        "firewall the port, or per-address limits can be dodged", self.proxy_hops)
         if self.required and self.accounts.count() == 0:
             where = (f"listening on {', '.join(self.listen_hosts)}" if self.listen_hosts else
                      "this server did not say where it listens: set ROVER_WEB_HOST to its address")

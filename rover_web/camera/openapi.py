@@ -19,7 +19,7 @@ ACK = query("ack", {"type": "string", "enum": ["0", "1"]},
             "1: the page will acknowledge the bytes it receives (POST /api/camera/viewers/{viewer_id}/ack), so "
             "the server sees the queue even behind a hop that terminates TCP; the response's X-Camera-Viewer "
             "header names the stream and each part carries X-Frame-Seq (adaptive streams only)")
-BAD = ("missing_topic, bad_topic, bad_value, out_of_range, unsupported_stream_type, type_mismatch, "
+BAD = ("missing_field, bad_topic, bad_value, out_of_range, unsupported_stream_type, type_mismatch, "
        "not_an_image_topic, unknown_type")
 
 PATHS = {
@@ -35,7 +35,8 @@ PATHS = {
                   ok={"type": "string", "contentMediaType": "image/jpeg"}, params=PARAMS,
                   errors={400: BAD, 404: "unknown_topic", 415: "an image the server cannot decode",
                           429: "rate_limited (CAMERA_SNAPSHOTS_PER_MIN; Retry-After)",
-                          503: "too_many_viewers, too_many_producers, shutting_down", 504: "no_frame"}),
+                          503: "too_many_viewers, too_many_producers, shutting_down", 504: "no_frame"},
+                  cross_site=True),
     },
     "/api/camera/streams": {"get": op("The open camera streams and viewers", tag="camera", ok=obj(closed=False))},
     "/api/camera/viewers": {

@@ -25,6 +25,10 @@ class FleetEStop:
     def engaged(self) -> bool:
         return any(estop.engaged for estop in self.robots.values())
 
+    @property
+    def all_engaged(self) -> bool:
+        return all(estop.engaged for estop in self.robots.values())
+
     def check_motion(self) -> None:
         """Raise EStopEngaged with the first engaged robot's latch."""
         for estop in self.robots.values():

@@ -73,17 +73,22 @@ def estop_all():
 def login_estop():
     """The sign-in page's e-stop: engages every robot, for anyone who can reach the page, signed in
     or not (docs/security.md#the-sign-in-pages-e-stop). It never releases, and takes no input but
-    the request itself: who is the client's address. Limited per address (each engage stores the
-    latch with an fsync); the Host and Origin guard applies as to every POST."""
+    the request itself: who is the client's address. The Host and Origin guard applies as to
+    every POST."""
     if not current_rover().config["ROVER_WEB_LOGIN_ESTOP"]:
         abort(404)
     address = request.remote_addr or "unknown"
-    wait_s = current_feature(FleetEStop).public_engages.hit(address)
+    fleet_estop = current_feature(FleetEStop)
+    wait_s = fleet_estop.public_engages.hit(address)
     as_json = request.mimetype == "application/json"
-    if wait_s > 0:
+    # The limit only bounds presses that change nothing (every robot already stopped): it must
+    # never stand between a person and a stop, and the address may be shared (a NAT, a proxy
+    # without ROVER_WEB_PROXY_HOPS) with someone who spent it first.
+    if wait_s > 0 and fleet_estop.all_engaged:
         if as_json:
-            raise too_many("e-stop engages from the sign-in page", wait_s)
-        return _login_page(429, f"too many e-stop engages from this address: try again in {wait_s:.0f} s",
+            raise too_many("e-stop engages from the sign-in page, and every robot is already engaged", wait_s)
+        return _login_page(429, "every robot's e-stop is already engaged, and this address pressed too often: "
+                                f"try again in {wait_s:.0f} s",
                            retry_after_s=wait_s)
     response = _engage_all(f"sign-in page ({address})"[:NAME_MAX_LEN])
     if as_json:

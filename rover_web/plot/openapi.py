@@ -19,7 +19,8 @@ PATHS = {
                           query("seconds", {"type": "number", "exclusiveMinimum": 0, "maximum": 86400},
                                 "how far back (default 60)"), TYPE],
                   errors={**REFUSED, 400: REFUSED[400] + ", bad_field, no_such_field, not_numeric, not_array, "
-                                                         "bad_seconds"}),
+                                                         "bad_seconds"},
+                  cross_site=True),
     },
     "/api/plot/fields": {
         "get": op("The numeric fields of a topic's type, as paths", tag="plot", ok=obj(closed=False),

@@ -13,7 +13,7 @@ PATHS = {
                   params=[query("topic", {"type": "string", "minLength": 1}, "the topic name", required=True),
                           query("type", {"type": "string", "examples": ["std_msgs/msg/String"]},
                                 "pkg/msg/Name; needed when the topic is not up yet or carries several")],
-                  errors={400: "missing_topic, bad_topic, bad_type, type_mismatch, ambiguous_type, unknown_type",
+                  errors={400: "missing_field, bad_topic, bad_type, type_mismatch, ambiguous_type, unknown_type",
                           404: "unknown_topic", 503: "too_many_streams, too_many_subscriptions, shutting_down"},
                   extra={"x-stream": "sse"}),
     },

@@ -7,6 +7,7 @@ from urllib.parse import urlsplit
 
 from flask import Flask, Request, current_app, jsonify, request
 from werkzeug.exceptions import HTTPException
+from werkzeug.middleware.proxy_fix import ProxyFix
 
 from .validate import InvalidInput, loads_strict
 
@@ -173,7 +174,25 @@ def _guard():
     return None
 
 
+def trust_proxies(app: Flask) -> None:
+    """Behind ROVER_WEB_PROXY_HOPS reverse proxies, believe what they forward.
+
+    Every per-address limit (sign-in back-off, the sign-in page's e-stop, stream shares with
+    sign-in off) keys on request.remote_addr; behind a proxy that is the proxy's address for every
+    client, so one client's failures would make everyone wait. Each proxy appends the address it
+    saw to X-Forwarded-For; ProxyFix takes the Nth value from the right, the one the outermost
+    trusted proxy wrote, so what a client put further left is never believed. With 0 nothing
+    forwarded is read: a client that reaches the app directly cannot choose its own address.
+    ProxyFix leaves the headers themselves in place, which keeps a proxied request "exposed"
+    under ROVER_WEB_AUTH=auto (auth/policy.py forwarded_header reads them, not REMOTE_ADDR).
+    """
+    hops = app.config["ROVER_WEB_PROXY_HOPS"]
+    if hops:
+        app.wsgi_app = ProxyFix(app.wsgi_app, x_for=hops, x_proto=hops, x_host=hops)
+
+
 def init_app(app: Flask) -> None:
+    trust_proxies(app)
     app.before_request(_guard)
     app.after_request(_security_headers)
 

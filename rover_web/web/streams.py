@@ -30,8 +30,8 @@ def sign_in_on() -> bool:
 def refuse_cross_site() -> None:
     """403 for a request another site's page made (`Sec-Fetch-Site: cross-site`) while sign-in is
     off. Such a GET (an <img src> or EventSource on any web page the operator visits) would create
-    subscriptions and streams on the robot with nobody's consent; with sign-in on, cookies are
-    SameSite=Lax and such a request is not signed in. Tools that are not browsers send no header."""
+    subscriptions and streams on the robot with nobody's consent; with sign-in on, the session
+    cookie is SameSite=Strict and such a request is not signed in. Tools that are not browsers send no header."""
     if request.headers.get("Sec-Fetch-Site", "").lower() == "cross-site" and not sign_in_on():
         raise ApiError(403, "cross_site", "another site's page may not open streams or subscriptions on this "
                                           "robot; open the GUI itself")

@@ -13,9 +13,11 @@ def test_defaults_are_valid_and_complete():
 
 def test_environment_overrides_defaults_with_types():
     settings = config.load(environ={"ROVER_WEB_PORT": "8080", "ROVER_WEB_CMD_VEL_STAMPED": "yes",
+                                    "ROVER_WEB_PROXY_HOPS": "2",
                                     "ROVER_WEB_TRUSTED_HOSTS": "robot.local, 10.0.0.5",
                                     "ROVER_WEB_LINK_TOPICS": "[\"/odom\", \"/fix\"]"})
     assert settings["ROVER_WEB_PORT"] == 8080
+    assert settings["ROVER_WEB_PROXY_HOPS"] == 2 and config.defaults()["ROVER_WEB_PROXY_HOPS"] == 0
     assert settings["ROVER_WEB_CMD_VEL_STAMPED"] is True
     assert settings["ROVER_WEB_TRUSTED_HOSTS"] == ["robot.local", "10.0.0.5"]
     assert settings["ROVER_WEB_LINK_TOPICS"] == ["/odom", "/fix"]
@@ -40,6 +42,8 @@ def test_file_then_environment_then_test_config(tmp_path):
     ("ROVER_WEB_CMD_VEL_TOPIC", "cmd vel!", "ROS topic name"),
     ("ROVER_WEB_TRUSTED_HOSTS", "[1, 2]", "list of strings"),
     ("ROVER_WEB_MAX_LINAER_MPS", "1", "unknown setting"),
+    ("ROVER_WEB_PROXY_HOPS", "-1", "from 0 to 10"),
+    ("ROVER_WEB_PROXY_HOPS", "yes", "an integer"),
 ])
 def test_bad_environment_value_names_the_key(key, value, words):
     with pytest.raises(ConfigError) as err:
