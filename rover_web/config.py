@@ -236,6 +236,9 @@ SETTINGS: tuple[Setting, ...] = (
     # --- camera over WebRTC (WHEP) ---
     Setting("WEBRTC_MAX_VIEWERS", 4, "int",
             "most WebRTC camera sessions at once, each with its own encoder (503 beyond: watch MJPEG)", 0, 64),
+    Setting("WEBRTC_VIEWERS_PER_CLIENT", 2, "int",
+            "most WebRTC camera sessions one user (one non-loopback address with sign-in off) may hold, 503 "
+            "beyond", 1, 64),
     Setting("WEBRTC_MAX_FPS", 30.0, "float", "most frames a second a WebRTC viewer is sent", 1, 60),
     Setting("WEBRTC_IDLE_TIMEOUT_S", 15.0, "float",
             "a WebRTC session not connected for this long (never, or lost) is closed", 1, 3600),

@@ -14,24 +14,31 @@ off), ROVER_WEB_ROS_ADMIN_ALLOW/_DENY and ROVER_WEB_ROS_ADMIN_SAFETY_NODES bound
 
 from __future__ import annotations
 
+import logging
+
 from flask import Flask
 
-from rover_web.config import ConfigError
+from rover_web.config import ConfigError, defaults
 from rover_web.core.state import Rover
 from rover_web.estop import FleetEStop
 
 from . import routes
+from .access import dropped, parse_rules
 from .service import RosAdmin, rules_from
 
 __all__ = ["init_app", "RosAdmin"]
+
+log = logging.getLogger(__name__)
 
 
 def init_app(app: Flask, rover: Rover) -> None:
     # Graph-wide: a call or goal names no robot, so any robot's e-stop refuses it and cancels it.
     try:
-        rules_from(rover.config)  # a bad entry stops the app at start, naming the setting
+        rules = rules_from(rover.config)  # a bad entry stops the app at start, naming the setting
     except ValueError as exc:
         raise ConfigError(str(exc)) from None
+    if rover.config["ROVER_WEB_ROS_ADMIN"] == "on":
+        warn_dropped_defaults(rules.deny)
     estop = rover.feature(FleetEStop)
     admin = RosAdmin(rover, estop)
     rover.add_feature(admin)
@@ -39,3 +46,13 @@ def init_app(app: Flask, rover: Rover) -> None:
     app.register_blueprint(routes.bp)
     if admin.mode != "off":
         rover.add_nav("ROS", "/ros")
+
+
+def warn_dropped_defaults(deny) -> None:
+    """Setting ROVER_WEB_ROS_ADMIN_DENY replaces the safe default list: one added entry (say
+    `node:/px4*`) silently let /ros set use_sim_time and call every set_parameters again."""
+    lost = dropped(deny, parse_rules(defaults()["ROVER_WEB_ROS_ADMIN_DENY"], "ROVER_WEB_ROS_ADMIN_DENY"))
+    if lost:
+        log.warning("ROVER_WEB_ROS_ADMIN_DENY replaces the default deny list and leaves out %d of its entries, "
+                    "which /ros may now write to: %s. To keep them, list them in the setting too "
+                    "(docs/ros_admin.md#allow-and-deny)", len(lost), ", ".join(str(r) for r in lost))

@@ -52,6 +52,19 @@ def matches_any(patterns: tuple[str, ...] | list[str], name: str) -> bool:
     return any(fnmatchcase(name, p) for p in patterns)
 
 
+def dropped(configured: tuple[Rule, ...], default: tuple[Rule, ...]) -> list[Rule]:
+    """The default rules the configured list no longer has. A default counts as kept only when an
+    entry says the same (or its kind's, or every kind's, `*`): glob containment in general cannot
+    be decided by matching one pattern's text against another, and a warning that says too little
+    here would hide a hole."""
+    def keeps(rule: Rule, entry: Rule) -> bool:
+        if rule == entry:
+            return True
+        return rule.kind in (None, entry.kind) and set(rule.pattern) == {"*"}
+
+    return [entry for entry in default if not any(keeps(rule, entry) for rule in configured)]
+
+
 class AccessRules:
     def __init__(self, allow: tuple[Rule, ...], deny: tuple[Rule, ...]):
         self.allow, self.deny = allow, deny

@@ -11,7 +11,8 @@ The e-stop itself is its own feature (rover_web.estop); teleop refuses motion wh
 and re-arms each socket on release only after a neutral input.
 
 Modules: service (the per-app object), routes, control (the controller) with commands, sessions,
-ramp, link and repeater, protocol (frames), websocket and ws_frames (the socket).
+ramp, link and repeater, rest_drive (a REST drive ends with its credential), protocol (frames),
+websocket and ws_frames (the socket).
 """
 
 from __future__ import annotations
@@ -56,3 +57,4 @@ def _init_robot(rover: Rover) -> None:
         log.warning("the e-stop is engaged (since the last run); release it to drive")
     teleop.repeater.start()
     rover.on_shutdown(teleop.repeater.stop)
+    rover.on_shutdown(teleop.rest.close)

@@ -50,6 +50,7 @@ class Command:
     session: Session | None      # None for REST
     fresh_at: float              # when its input was fresh: a socket's frame dates from when it was sent
     expires_at: float            # the hard bound after fresh_at, or the end of a REST command's duration
+    owner: object = None         # a REST command's starter (rest_drive.py), so only its revocation ends it
 
 
 class Refused(Exception):

@@ -226,8 +226,9 @@ class TeleopController:
             self._changed()
             return True
 
-    def rest_command(self, command: str, speed: float, duration_s: float) -> tuple[float, float]:
-        """POST /api/teleop: drive for `duration_s`, then stop by itself."""
+    def rest_command(self, command: str, speed: float, duration_s: float,
+                     owner: object = None) -> tuple[float, float]:
+        """POST /api/teleop: drive for `duration_s`, then stop by itself (or by `end_rest(owner)`)."""
         with self._cond:
             now = self._clock()
             self._expire(now)
@@ -242,7 +243,7 @@ class TeleopController:
                               holder=self._holder.public())
             direction = REST_COMMANDS[command]
             linear_mps, angular_rps = scale(direction[0] * speed, direction[1] * speed, self.limits)
-            self._command = Command(linear_mps, angular_rps, "rest", None, now, now + duration_s)
+            self._command = Command(linear_mps, angular_rps, "rest", None, now, now + duration_s, owner)
             self._publish_command(now)
             self._next_tick = now + self.period_s
             self._changed()
@@ -255,6 +256,17 @@ class TeleopController:
             self._expire(self._clock())
             self._stop("rest_stop", bump=[self._holder] if self._holder else (), always=True)
             self._changed()
+
+    def end_rest(self, owner: object, reason: str) -> bool:
+        """Stop the REST command under way if `owner` started it (its credential ended); False if
+        another command, or none, is held: someone else's drive goes on."""
+        with self._cond:
+            command = self._command
+            if owner is None or command is None or command.session is not None or command.owner is not owner:
+                return False
+            self._stop(reason)
+            self._changed()
+            return True
 
     # --- e-stop latch ---
 

@@ -102,7 +102,9 @@ def teleop_command():
     except InvalidInput as exc:
         raise ApiError(400, exc.code, str(exc)) from None
     try:
-        linear_mps, angular_rps = teleop.controller.rest_command(command, speed, duration_s)
+        # The drive outlives this request: its credential is watched until the next one replaces
+        # it, and a revocation stops it at once (rest_drive.py).
+        linear_mps, angular_rps = teleop.rest.start(command, speed, duration_s, on_revoke)
     except Refused as exc:
         raise ApiError(exc.status, exc.code, exc.message) from None
     return jsonify(command=command, speed=speed, duration_s=duration_s, linear_mps=linear_mps,

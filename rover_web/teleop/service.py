@@ -11,6 +11,7 @@ from rover_web.estop import EStopService
 from .commands import Limits
 from .control import TeleopController
 from .repeater import Repeater
+from .rest_drive import RestDrives
 
 log = logging.getLogger(__name__)
 
@@ -40,6 +41,7 @@ class TeleopService:
         estop.on_release(self.controller.release_estop)
         rover.on_link_lost(self.controller.link_lost)
         self.repeater = Repeater(self.controller)
+        self.rest = RestDrives(self.controller)
         self.max_frame_bytes = config["ROVER_WEB_TELEOP_MAX_FRAME_BYTES"]
 
     def hello(self) -> dict:

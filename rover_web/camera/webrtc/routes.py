@@ -8,6 +8,7 @@ from rover_web.auth import AuthService, current_identity, may, on_revoke, signed
 from rover_web.camera.service import StreamRefused
 from rover_web.core.state import current_feature
 from rover_web.web.http import ApiError, accepts_media, error_response
+from rover_web.web.streams import opening
 from rover_web.web.validate import InvalidInput
 
 from .service import WebRtcService
@@ -37,8 +38,12 @@ def whep_offer():
     service = current_feature(WebRtcService)
     sign_in = current_feature(AuthService).sign_in_on()
     identity = current_identity()
-    session_id, answer = service.open(request.args, request.get_data(as_text=True), user=signed_in_name(),
-                                      role=getattr(identity, "role", None), may_operate=may("operator", sign_in))
+    # The slot is taken here, in the request, where the client (user or address), its share of the
+    # stream cap and whether it may use the reserve kept for driving are known (web/streams.py).
+    with opening("webrtc") as slot:
+        session_id, answer = service.open(request.args, request.get_data(as_text=True), user=signed_in_name(),
+                                          role=getattr(identity, "role", None), may_operate=may("operator", sign_in),
+                                          slot=slot)
     # Its credential is watched from now on: a revoked token, a removed user, a new role or password
     # or a sign-out ends the peer connection, and with it the teleop channel (docs/security.md).
     service.watch(session_id, on_revoke(lambda reason: service.revoke(session_id, reason)))

@@ -3,9 +3,12 @@ carry the teleop data channel.
 
 Lifecycle of a session (all peer-connection work on the LoopThread):
 - `open` (a request thread): the query is checked as /stream's (CameraStreams.key_for), a viewer
-  place (ROVER_WEB_WEBRTC_MAX_VIEWERS) and a slot of ROVER_WEB_MAX_STREAMS are taken, the shared
-  frame producer is leased, then the offer is answered on the loop (candidates gathered before
-  answering: no trickle). Any failure gives all of it back before the error is answered.
+  place (ROVER_WEB_WEBRTC_MAX_VIEWERS, at most ROVER_WEB_WEBRTC_VIEWERS_PER_CLIENT of them per
+  client) is taken with the slot of ROVER_WEB_MAX_STREAMS the route took for the client
+  (web/streams.py: its share, and the reserve left for driving), the shared frame producer is
+  leased against the client's share of encodings, then the offer is answered on the loop
+  (candidates gathered before answering: no trickle). Any failure gives all of it back before the
+  error is answered.
 - it ends on DELETE, when its peer connection fails or closes, when it has not been connected for
   ROVER_WEB_WEBRTC_IDLE_TIMEOUT_S (never connected, or lost), when its user is revoked
   (`close_sessions_of`), and at shutdown; `_end` gives everything back exactly once.
@@ -33,9 +36,9 @@ from rover_web.camera import msgs as camera_msgs
 from rover_web.camera.service import CameraStreams, CannotSubscribe, Unavailable
 from rover_web.camera.stream import FrameProducer, StreamKey
 from rover_web.config import ConfigError
-from rover_web.core.leases import Closed, Full, Leases
+from rover_web.core.leases import Closed, Full, Leases, ShareUsed
 from rover_web.core.state import Rover
-from rover_web.core.streams import StreamSlot, TooManyStreams
+from rover_web.core.streams import StreamSlot
 from rover_web.web.validate import InvalidInput
 
 from . import frames
@@ -81,6 +84,11 @@ class WhepSession:
     ended: str | None = None  # why it ended
     remb_bps: int | None = None  # the browser's latest estimate, unclamped
     revocation: Any = None  # its credential's registration (auth/revocation.py), cancelled when it ends
+
+    @property
+    def client(self) -> str | None:
+        """Whose shares it counts against (web/streams.py's client_key), as its stream slot says."""
+        return self.slot.client
 
     def encoder_bitrate(self) -> int | None:
         # aiortc sets its encoder's target from each REMB packet, clamped (250 kbit/s to 1.5 Mbit/s
@@ -170,6 +178,8 @@ class WebRtcService:
         self.loop = loop
         self.camera = camera
         self.max_viewers = config["ROVER_WEB_WEBRTC_MAX_VIEWERS"]
+        self.viewers_per_client = config["ROVER_WEB_WEBRTC_VIEWERS_PER_CLIENT"]
+        self.producers_per_client = config["ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT"]
         self.idle_timeout_s = config["ROVER_WEB_WEBRTC_IDLE_TIMEOUT_S"]
         self.max_fps = config["ROVER_WEB_WEBRTC_MAX_FPS"]
         self.host_addresses = host_addresses(config)
@@ -262,9 +272,12 @@ class WebRtcService:
     def describe(self) -> dict:
         return {"max_viewers": self.max_viewers, "sessions": [s.describe() for s in self.sessions()]}
 
-    def open(self, args, offer: str, *, user: str | None, role: str | None, may_operate: bool) -> tuple[str, str]:
+    def open(self, args, offer: str, *, user: str | None, role: str | None, may_operate: bool,
+             slot: StreamSlot) -> tuple[str, str]:
         """Answer a WHEP offer: (session id, SDP answer). InvalidInput, UnknownTopic, Unavailable,
-        CannotSubscribe as CameraStreams raises them."""
+        CannotSubscribe as CameraStreams raises them. `slot` is the request's slot of the stream cap,
+        taken for its client in the request thread (web/streams.py); the session owns it from now on,
+        and gives it back when it ends, or at once when it cannot be made."""
         key = self.camera.key_for(args)
         if len(offer) > MAX_OFFER_CHARS:
             raise InvalidInput(f"the offer is longer than {MAX_OFFER_CHARS} characters", "bad_sdp")
@@ -272,12 +285,17 @@ class WebRtcService:
             raise InvalidInput("the body is not an SDP offer (it must start with v=0)", "bad_sdp")
         if "\nm=video " not in offer.replace("\r\n", "\n"):
             raise NoVideo("the offer has no video media section: add a recvonly video transceiver", "no_video")
-        session = self._reserve(key, user, role, may_operate)
+        session = self._reserve(key, user, role, may_operate, slot)
         try:
+            client = session.client
             try:
-                session.producer = self.producers.acquire(key)
+                session.producer = self.producers.acquire(key, client, None if client is None
+                                                          else self.producers_per_client)
             except Closed:
                 raise Unavailable("the server is shutting down", "shutting_down") from None
+            except ShareUsed as exc:
+                raise Unavailable(f"{exc} different WebRTC camera streams (ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT); "
+                                  "close one first", "too_many_producers") from None
             except Full:
                 raise Unavailable(f"{len(self.producers)} different WebRTC camera streams are converted already "
                                   "(ROVER_WEB_CAMERA_MAX_PRODUCERS); view one of them", "too_many_producers") from None
@@ -295,21 +313,29 @@ class WebRtcService:
             raise
         return session.id, answer
 
-    def _reserve(self, key: StreamKey, user: str | None, role: str | None, may_operate: bool) -> WhepSession:
-        with self._lock:
-            if self._closed:
-                raise Unavailable("the server is shutting down", "shutting_down")
-            if len(self._sessions) >= self.max_viewers:
-                raise Unavailable(f"{len(self._sessions)} WebRTC viewers are connected already "
-                                  f"(ROVER_WEB_WEBRTC_MAX_VIEWERS); watch the MJPEG stream instead: "
-                                  f"GET /stream?topic={key.topic}", "too_many_webrtc_viewers")
-            try:
-                slot = self.rover.streams.acquire("webrtc")
-            except TooManyStreams as exc:
-                raise Unavailable(str(exc), "too_many_streams") from None
-            session = WhepSession(secrets.token_urlsafe(16), user, role, may_operate, key, slot)
-            self._sessions[session.id] = session
-            return session
+    def _reserve(self, key: StreamKey, user: str | None, role: str | None, may_operate: bool,
+                 slot: StreamSlot) -> WhepSession:
+        try:
+            with self._lock:
+                if self._closed:
+                    raise Unavailable("the server is shutting down", "shutting_down")
+                if len(self._sessions) >= self.max_viewers:
+                    raise Unavailable(f"{len(self._sessions)} WebRTC viewers are connected already "
+                                      f"(ROVER_WEB_WEBRTC_MAX_VIEWERS); watch the MJPEG stream instead: "
+                                      f"GET /stream?topic={key.topic}", "too_many_webrtc_viewers")
+                # Each session has its own encoder and a place of few: one client must leave the
+                # others some, whatever its share of the much larger stream cap.
+                held = 0 if slot.client is None else sum(s.client == slot.client for s in self._sessions.values())
+                if held >= self.viewers_per_client:
+                    raise Unavailable(f"this client holds {held} WebRTC viewer places already, its share "
+                                      f"(ROVER_WEB_WEBRTC_VIEWERS_PER_CLIENT); close one, or watch the MJPEG "
+                                      f"stream instead: GET /stream?topic={key.topic}", "too_many_webrtc_viewers")
+                session = WhepSession(secrets.token_urlsafe(16), user, role, may_operate, key, slot)
+                self._sessions[session.id] = session
+                return session
+        except BaseException:
+            slot.release()
+            raise
 
     def _abandon(self, session: WhepSession) -> None:
         """An offer that failed: its peer connection (if any) closed on the loop, the rest given back."""
@@ -457,6 +483,6 @@ class WebRtcService:
         if session.revocation is not None:
             session.revocation.cancel()
         if session.producer is not None:
-            self.producers.release(session.key)
+            self.producers.release(session.key, session.client)
         session.slot.release()
 

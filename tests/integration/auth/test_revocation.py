@@ -207,3 +207,65 @@ def test_a_topic_echo_ends_when_its_session_signs_out(signed_server, ros_peer, s
     browser.post(signed_server.url + "/logout", json={}, timeout=5).raise_for_status()
     assert echo.closed.wait(CLOSED_WITHIN_S), "the signed-out viewer's echo goes on"
     browser.close()
+
+
+# --- REST drives: no socket stays open, yet the drive goes on for up to its duration ---
+
+def rest_drive(server, **credentials) -> None:
+    answer = requests.post(server.url + "/api/teleop", json={"command": "forward", "speed": 0.5, "duration_s": 5.0},
+                           timeout=5, **credentials)
+    assert answer.ok, answer.text
+
+
+def teleop_state(server) -> dict:
+    return requests.get(server.url + "/api/teleop", headers=bearer(server, "admin"), timeout=5).json()
+
+
+def assert_rest_drive_stops_when(rig, revoke, **credentials):
+    """A REST drive of 5 s under way, then revoke(): a zero on /cmd_vel after the motion well before
+    the drive would have ended, and nothing moves after it."""
+    server, peer = rig
+    rest_drive(server, **credentials)
+    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] > 0, timeout=10)
+    revoke()
+    # The revocation is handled before its request is answered: the drive is over now.
+    state = teleop_state(server)
+    assert not state["moving"] and state["last_stop"]["reason"] == "revoked", state
+    zero_seen = wait_until(lambda: [i for i, (_, lin, ang) in enumerate(twists(peer)) if lin == ang == 0.0
+                                    and any(m[1] > 0 for m in twists(peer)[:i])],
+                           timeout=CLOSED_WITHIN_S, what="a zero on /cmd_vel after the motion")
+    assert all(lin == 0.0 and ang == 0.0 for _, lin, ang in twists(peer)[zero_seen[0]:])
+
+
+def test_a_revoked_token_stops_the_rest_drive_it_started(rig):
+    server, _ = rig
+    operator_token = token_id(server, "operator")
+
+    def revoke():
+        assert requests.delete(f"{server.url}/api/tokens/{operator_token}", headers=bearer(server, "admin"),
+                               timeout=5).ok
+
+    assert_rest_drive_stops_when(rig, revoke, headers=bearer(server, "operator"))
+
+
+def test_signing_out_stops_the_rest_drive_that_session_started(rig):
+    server, _ = rig
+    browser, cookie = session_cookie(server, "operator")
+    try:
+        assert_rest_drive_stops_when(rig, lambda: browser.post(server.url + "/logout", json={},
+                                                               timeout=5).raise_for_status(),
+                                     headers={"Cookie": f"session={cookie}"})
+    finally:
+        browser.close()
+
+
+def test_a_revocation_leaves_a_rest_drive_someone_else_started_since(rig):
+    server, peer = rig
+    rest_drive(server, headers=bearer(server, "operator"))
+    rest_drive(server, headers=bearer(server, "admin"))  # replaces the operator's drive
+    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] > 0, timeout=10)
+    operator_token = token_id(server, "operator")
+    assert requests.delete(f"{server.url}/api/tokens/{operator_token}", headers=bearer(server, "admin"), timeout=5).ok
+    assert teleop_state(server)["moving"]
+    assert requests.post(server.url + "/api/teleop", json={"command": "stop"}, headers=bearer(server, "admin"),
+                         timeout=5).ok

@@ -137,6 +137,41 @@ def test_a_bad_rule_stops_the_app_at_start(app_factory):
         app_factory(ROVER_WEB_ROS_ADMIN_DENY=["topic:/x"])
 
 
+def docs_example_deny() -> list[str]:
+    """The ROVER_WEB_ROS_ADMIN_DENY of docs/ros_admin.md's example."""
+    from rover_web.config import ROOT
+
+    text = (ROOT / "docs" / "ros_admin.md").read_text()
+    line = next(line for line in text.splitlines() if line.startswith("ROVER_WEB_ROS_ADMIN_DENY='"))
+    return line.split("'")[1].split(",")
+
+
+def dropped_warnings(caplog) -> list[str]:
+    return [r.getMessage() for r in caplog.records
+            if r.levelname == "WARNING" and "ROVER_WEB_ROS_ADMIN_DENY replaces" in r.getMessage()]
+
+
+def test_a_deny_list_that_leaves_out_defaults_is_warned_of_at_start(app_factory, caplog):
+    caplog.set_level("WARNING", logger="rover_web")
+    app_factory(ROVER_WEB_ROS_ADMIN_DENY=["param:use_sim_time", "service:*/set_parameters*", "service:*/change_state",
+                                          "service:*/_action/*", "service:*/_container/*", "node:/px4*"])
+    [warning] = dropped_warnings(caplog)
+    assert "2 of its entries" in warning
+    assert "service:*/load_parameters" in warning and "service:*/manage_nodes" in warning
+    assert "use_sim_time" not in warning and "change_state" not in warning
+    assert "docs/ros_admin.md" in warning
+
+
+@pytest.mark.parametrize("settings", [{}, {"ROVER_WEB_ROS_ADMIN": "read-only", "ROVER_WEB_ROS_ADMIN_DENY": ["node:/x"]},
+                                      {"ROVER_WEB_ROS_ADMIN_DENY": "docs"}], ids=["default", "read-only", "docs"])
+def test_no_warning_for_the_default_a_read_only_admin_or_the_docs_example(app_factory, caplog, settings):
+    caplog.set_level("WARNING", logger="rover_web")
+    if settings.get("ROVER_WEB_ROS_ADMIN_DENY") == "docs":
+        settings = {"ROVER_WEB_ROS_ADMIN_DENY": docs_example_deny()}
+    app_factory(**settings)
+    assert dropped_warnings(caplog) == []
+
+
 def test_safety_nodes_keep_their_parameters_while_the_estop_is_engaged(client, admin_peer):
     """The default ROVER_WEB_ROS_ADMIN_SAFETY_NODES is every node."""
     wait_for_parameters(client)

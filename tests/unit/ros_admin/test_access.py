@@ -102,3 +102,18 @@ def test_hidden_values_and_scrubbed_logs():
                       {"name": "gain", "value": 1.0, "hidden": False}]
     assert scrub({"user": "a", "password": "b", "inner": [{"Token": "c", "n": 1}]}) == {
         "user": "a", "password": HIDDEN, "inner": [{"Token": HIDDEN, "n": 1}]}
+
+
+def test_a_configured_deny_list_names_the_defaults_it_leaves_out():
+    from rover_web.ros_admin.access import dropped
+
+    default = parse_rules(DEFAULT_DENY, "DENY")
+    assert dropped(parse_rules(["node:/px4*"], "DENY"), default) == list(default)
+    assert dropped(parse_rules([*DEFAULT_DENY, "node:/px4*"], "DENY"), default) == []
+    # A `*` of the kind (or of every kind) keeps them; a narrower look-alike does not.
+    assert dropped(parse_rules(["param:*", "service:*"], "DENY"), default) == []
+    assert dropped(parse_rules(["*"], "DENY"), default) == []
+    kept_but_one = [e for e in DEFAULT_DENY if e != "service:*/set_parameters*"] + ["service:*/set_parameters"]
+    assert [str(r) for r in dropped(parse_rules(kept_but_one, "DENY"), default)] == ["service:*/set_parameters*"]
+    assert [str(r) for r in dropped(parse_rules(["param:*", "node:*"], "DENY"), default)] == \
+        [e for e in DEFAULT_DENY if e.startswith("service:")]
