@@ -334,6 +334,7 @@ def run(args) -> dict:
         counters = emu.counters()
         route = viewer.route() if webrtc else None
         sizes = viewer.size_shares(t_start, t_end) if webrtc else None
+        jitter = {"holes_given_up": viewer.jitter.given_up, "frames_dropped": viewer.jitter.dropped} if webrtc else None
     finally:
         for part in (viewer, events):
             if part is not None:
@@ -407,6 +408,8 @@ def run(args) -> dict:
         "webrtc_route": route,
         "webrtc_sizes": sizes,  # decoded frame sizes in the hold, with their share of frames
         "webrtc_server": server_said_video if webrtc else None,
+        # the viewer's jitter buffer (bench/browser_jitter.py): lost packets given up, frames dropped until a keyframe
+        "webrtc_jitter": jitter,
         "emulator_udp_port": emu.udp_port if webrtc else None,
         "server_ice_port": viewer.server_port if webrtc else None,
         "load_avg": [round(load_before, 1), round(os.getloadavg()[0], 1)],  # the machine's, start and end
