@@ -323,7 +323,7 @@ def run(args) -> dict:
         if webrtc:  # what the server's adaptation chose by the end of the hold (asked on loopback, not the link)
             session = requests.get(server.url + "/api/camera/whep", timeout=10).json()["sessions"]
             server_said_video = {k: session[0].get(k) for k in ("level", "width", "height", "fps", "target_bps",
-                                                               "remb_bps")} if session else None
+                                                               "remb_bps", "loss_keyframes")} if session else None
         stick.release()
         twists = sub.since(mark)
         said = dict(ws.heard.counts)
