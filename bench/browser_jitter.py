@@ -12,9 +12,10 @@ aiortc's own (aiortc/jitterbuffer.py, 1.16) made the link bench measure aiortc, 
   on it, asks for a keyframe and asks again until one comes.
 
 This one does the same: a frame is complete at its marker bit when none of its packets is
-missing; a hole still open after GIVE_UP_S (several NACK round trips on the bench's links) is
-given up, the frames after it are dropped until a VP8 keyframe, and a keyframe is asked for (the
-PLI aiortc's receiver sends when `add` says so) then and every KEYFRAME_RETRY_S until one comes.
+missing; a hole still open after GIVE_UP_S (several NACK round trips on the bench's links), or
+followed by a whole keyframe, is given up, the frames after it are dropped until a VP8 keyframe,
+and a keyframe is asked for (the PLI aiortc's receiver sends when `add` says so) then and every
+KEYFRAME_RETRY_S until one comes.
 Installed by `install(receiver)` on a video RTCRtpReceiver, a private attribute (aiortc is pinned).
 """
 
@@ -78,10 +79,29 @@ class BrowserJitterBuffer:
         while (frame := self._frame_at_next()) is not None:
             if frame is not False:
                 frames.append(frame)
-        if (seen := self._hole_seen()) is not None and now - seen >= GIVE_UP_S:
+        if (seen := self._hole_seen()) is not None and (now - seen >= GIVE_UP_S or self._keyframe_after_hole()):
             self._give_up()
             frames += self._take(now)
         return frames
+
+    def _keyframe_after_hole(self) -> bool:
+        """A whole keyframe has come after the hole: a browser decodes it at once, whatever is missing
+        before it (it needs nothing earlier)."""
+        held = self._held()
+        for i, seq in enumerate(held):
+            if seq != uint16_add(self._next, i):
+                break
+        else:
+            return False
+        for seq in held[i:]:
+            first = self._packets[seq]
+            if starts_vp8_frame(first) and is_vp8_keyframe(first):
+                n = seq
+                while (p := self._packets.get(n)) is not None and p.timestamp == first.timestamp:
+                    if p.marker:
+                        return True
+                    n = uint16_add(n, 1)
+        return False
 
     def _held(self) -> list[int]:
         return sorted(self._packets, key=lambda s: uint16_add(s, -self._next))
