@@ -306,7 +306,7 @@ def run(args) -> dict:
         if webrtc:  # what the server's adaptation chose by the end of the hold (asked on loopback, not the link)
             session = requests.get(server.url + "/api/camera/whep", timeout=10).json()["sessions"]
             server_said_video = {k: session[0].get(k) for k in ("level", "width", "height", "fps", "target_bps",
-                                                               "remb_bps")} if session else None
+                                                               "remb_bps", "loss_keyframes")} if session else None
         stick.release()
         twists = sub.since(mark)
         said = dict(ws.heard.counts)
@@ -319,6 +319,7 @@ def run(args) -> dict:
         counters = emu.counters()
         route = viewer.route() if webrtc else None
         sizes = viewer.size_shares(t_start, t_end) if webrtc else None
+        jitter = {"holes_given_up": viewer.jitter.given_up, "frames_dropped": viewer.jitter.dropped} if webrtc else None
     finally:
         for part in (viewer, events):
             if part is not None:
@@ -345,6 +346,9 @@ def run(args) -> dict:
     ages = [age for _, age, _ in frames if age is not None]
     ages_outside = [age for t, age, _ in frames  # issue 26's radio target is "outside outages"
                     if age is not None and not any(a <= t <= b + OUTAGE_GRACE_S for a, b in outages)]
+    # A stall holds every byte: frames made during it arrive that much older whatever the video does.
+    ages_clear = [age for t, age, _ in frames
+                  if age is not None and not any(a <= t <= b + OUTAGE_GRACE_S for a, b, _ in windows)]
     estop_frames = viewer.window(t_estop, t_estop_end) if viewer else []
     # An e-stop the link itself held (a stall or an outage overlapping it) measures the link, not
     # what stood in front of the e-stop in its queue.
@@ -388,6 +392,7 @@ def run(args) -> dict:
         "frame_age_p50_ms": ms(ages, 50),
         "frame_age_p99_ms": ms(ages, 99),
         "frame_age_p99_outside_outages_ms": ms(ages_outside, 99),  # frames arriving in an outage or 1 s after left out
+        "frame_age_p99_outside_stalls_ms": ms(ages_clear, 99),  # ... and in a stall or 1 s after
         "video_fps_during_estops": round(len(estop_frames) / max(1e-9, t_estop_end - t_estop), 2),
         "event_age_p50_ms": ms(event_ages, 50),
         "event_age_p99_ms": ms(event_ages, 99),
@@ -401,6 +406,8 @@ def run(args) -> dict:
         "webrtc_route": route,
         "webrtc_sizes": sizes,  # decoded frame sizes in the hold, with their share of frames
         "webrtc_server": server_said_video if webrtc else None,
+        # the viewer's jitter buffer (bench/browser_jitter.py): lost packets given up, frames dropped until a keyframe
+        "webrtc_jitter": jitter,
         "emulator_udp_port": emu.udp_port if webrtc else None,
         "server_ice_port": viewer.server_port if webrtc else None,
         "load_avg": [round(load_before, 1), round(os.getloadavg()[0], 1)],  # the machine's, start and end
@@ -436,7 +443,8 @@ def table(r: dict) -> str:
         ("video", f"{r['video']}: {r['video_fps']} fps, {r['video_kbps']} kbit/s, "
                   f"frame age p50 {f(r['frame_age_p50_ms'], ' ms')}"
                   f", p99 {f(r['frame_age_p99_ms'], ' ms')} (outside outages "
-                  f"{f(r['frame_age_p99_outside_outages_ms'], ' ms')}; {r['frames_unreadable']} unreadable)"),
+                  f"{f(r['frame_age_p99_outside_outages_ms'], ' ms')}, outside stalls and outages "
+                  f"{f(r['frame_age_p99_outside_stalls_ms'], ' ms')}; {r['frames_unreadable']} unreadable)"),
         ("odom events", f"{r['events_per_s']} /s, age p50 {f(r['event_age_p50_ms'], ' ms')}, "
                         f"p99 {f(r['event_age_p99_ms'], ' ms')}"),
     ]

@@ -28,6 +28,7 @@ import socket
 import threading
 import time
 
+import browser_jitter
 import requests
 from aiortc import RTCConfiguration, RTCPeerConnection, RTCSessionDescription
 from common import count_rtp_payload, decoded_frames
@@ -100,6 +101,7 @@ class LinkWhep:
             self.pc = pc = RTCPeerConnection(RTCConfiguration(iceServers=[]))
             receiver = pc.addTransceiver("video", direction="recvonly").receiver
             count_rtp_payload(receiver, self._count)  # the payload bytes the link carried for video
+            self.jitter = browser_jitter.install(receiver)  # frames to the decoder as a browser gives them
             if teleop:
                 self.channel = pc.createDataChannel("teleop", ordered=False, maxRetransmits=0)
                 self.channel.on("open", self.channel_open.set)

@@ -43,6 +43,7 @@ from rover_web.web.validate import InvalidInput
 
 from . import frames
 from .adapt import AdaptPolicy
+from .feedback import tap_rtcp
 from .ice import candidate_address, check_addresses, filter_candidates, only_host_addresses, parse_ice_server
 from .loop import LoopStopped, LoopThread
 
@@ -83,6 +84,7 @@ class WhepSession:
     last_connected: float | None = None
     ended: str | None = None  # why it ended
     remb_bps: int | None = None  # the browser's latest estimate, unclamped
+    loss_keyframes: int = 0  # keyframes sent instead of resending what could not help (feedback.py)
     revocation: Any = None  # its credential's registration (auth/revocation.py), cancelled when it ends
 
     @property
@@ -109,6 +111,7 @@ class WhepSession:
                 "level": out.level if out else None, "width": out.width if out else None,
                 "height": out.height if out else None, "fps": out.fps if out else None,
                 "target_bps": self.encoder_bitrate(), "remb_bps": self.remb_bps,
+                "loss_keyframes": self.loss_keyframes,
                 "teleop": self.teleop is not None and not self.teleop.closed,
                 "source_hz": self.producer.arrivals.snapshot(stale_after_s=2.0)["rate_hz"] if self.producer else None,
                 "age_s": round(time.monotonic() - self.created, 1)}
@@ -149,26 +152,6 @@ def _check_fingerprints(offer: str) -> None:
         if not any(f.algorithm in X509_DIGEST_ALGORITHMS for f in media.dtls.fingerprints):
             raise InvalidInput(f"the offer's {media.kind} section has no DTLS fingerprint this server can check "
                                f"({', '.join(X509_DIGEST_ALGORITHMS)})", "bad_sdp")
-
-
-def tap_remb(session: WhepSession) -> None:
-    """Keep each REMB estimate the browser sends for this sender, before aiortc clamps it."""
-    from aiortc.rtp import RTCP_PSFB_APP, RtcpPsfbPacket, unpack_remb_fci
-
-    sender = session.sender
-    handle = sender._handle_rtcp_packet  # called per RTCP packet by the DTLS transport's router
-
-    async def _handle(packet) -> None:
-        if isinstance(packet, RtcpPsfbPacket) and packet.fmt == RTCP_PSFB_APP:
-            try:
-                bitrate, ssrcs = unpack_remb_fci(packet.fci)
-            except ValueError:
-                bitrate, ssrcs = None, ()
-            if bitrate is not None and sender._ssrc in ssrcs:
-                session.remb_bps = bitrate
-        await handle(packet)
-
-    sender._handle_rtcp_packet = _handle
 
 
 class WebRtcService:
@@ -384,7 +367,7 @@ class WebRtcService:
             session.track = track
             video[0].direction = "sendonly"
             session.sender = pc.addTrack(track)
-            tap_remb(session)
+            tap_rtcp(session)
             try:
                 answer = await pc.createAnswer()
                 await pc.setLocalDescription(answer)

@@ -51,7 +51,7 @@ class CameraTrack(MediaStreamTrack):
         self._pool = pool
         self._seq = 0
         self._started: float | None = None
-        self._last_sent = 0.0
+        self._due = 0.0  # when the next frame may be taken
         self._last_pts = -1
         self.frames_sent = 0
         self.output: Output | None = None
@@ -61,9 +61,10 @@ class CameraTrack(MediaStreamTrack):
     async def recv(self) -> av.VideoFrame:
         loop = asyncio.get_running_loop()
         if self.output is not None:  # pace to the viewer's frame rate; the newest frame is taken after
-            wait = self._last_sent + 1.0 / self.output.fps - time.monotonic()
+            wait = self._due - time.monotonic()
             if wait > 0:
                 await asyncio.sleep(wait)
+        slot = time.monotonic()
         while True:
             if self.readyState != "live":
                 raise MediaStreamError
@@ -87,7 +88,11 @@ class CameraTrack(MediaStreamTrack):
         frame.pts = max(pts, self._last_pts + 1)  # strictly increasing, whatever the clock did
         frame.time_base = TIME_BASE
         self._last_pts = frame.pts
-        self._last_sent = now
+        # The next slot one period after this one's, not after this frame was made: timed from the
+        # end of the conversion (and its wait for a camera frame newer than the last), 15 fps came
+        # out as 13 and 30 as 24. A slot taken late moves the next no closer than half a period.
+        period = 1.0 / self.output.fps
+        self._due = max(self._due + period, slot + period / 2)
         self.last_stamp = picture.stamp
         self.frames_sent += 1
         return frame

@@ -44,11 +44,13 @@ def test_steps_down_frame_rate_first_then_size_then_rate_again(policy):
     need0 = p.needs_bps(0, 640, 480)
     assert need0 == pytest.approx(0.05 * 640 * 480 * 30)
     out = run(p, clock, 30_000, DOWN_AFTER_S + 0.3)
-    assert (out.width, out.height, out.fps, out.level) == (640, 480, 15.0, 1)
+    assert (out.width, out.height, out.level) == (640, 480, 1) and out.fps == pytest.approx(20.0)
     out = run(p, clock, 30_000, DOWN_AFTER_S + 0.3)
-    assert (out.width, out.height, out.fps, out.level) == (320, 240, 15.0, 2)
+    assert (out.width, out.height, out.fps, out.level) == (640, 480, 15.0, 2)
     out = run(p, clock, 30_000, DOWN_AFTER_S + 0.3)
-    assert (out.width, out.height, out.level) == (320, 240, 3) and out.fps == pytest.approx(10.0)
+    assert (out.width, out.height, out.fps, out.level) == (320, 240, 15.0, 3)
+    out = run(p, clock, 30_000, DOWN_AFTER_S + 0.3)
+    assert (out.width, out.height, out.level) == (320, 240, 4) and out.fps == pytest.approx(10.0)
     out = run(p, clock, 30_000, 10)  # the floor: nothing lower
     assert out.level == len(LEVELS) - 1
 
@@ -62,16 +64,16 @@ def test_a_short_dip_does_not_step_down(policy):
 
 def test_recovers_only_with_headroom_held_for_a_while(policy):
     p, clock = policy
-    run(p, clock, 30_000, 3 * (DOWN_AFTER_S + 0.3))
-    assert p.level == 3
-    up_to_2 = p.needs_bps(2, 640, 480)
-    # Just enough for level 2, but without the headroom: stays.
-    assert run(p, clock, up_to_2 * 1.01, UP_AFTER_S * 3).level == 3
+    run(p, clock, 30_000, 4 * (DOWN_AFTER_S + 0.3))
+    assert p.level == 4
+    up_to_3 = p.needs_bps(3, 640, 480)
+    # Just enough for level 3, but without the headroom: stays.
+    assert run(p, clock, up_to_3 * 1.01, UP_AFTER_S * 3).level == 4
     # With the headroom, but not for long enough: stays.
-    assert run(p, clock, up_to_2 * UP_HEADROOM, UP_AFTER_S * 0.8).level == 3
-    assert run(p, clock, up_to_2 * UP_HEADROOM, UP_AFTER_S * 0.3).level == 2
+    assert run(p, clock, up_to_3 * UP_HEADROOM, UP_AFTER_S * 0.8).level == 4
+    assert run(p, clock, up_to_3 * UP_HEADROOM, UP_AFTER_S * 0.3).level == 3
     # A good link brings it all the way back, one level per UP_AFTER_S.
-    out = run(p, clock, 5_000_000, 2 * UP_AFTER_S + 0.5)
+    out = run(p, clock, 5_000_000, 3 * UP_AFTER_S + 0.5)
     assert (out.width, out.height, out.fps, out.level) == (640, 480, 30.0, 0)
 
 

@@ -1,0 +1,73 @@
+"""What the browser's RTCP feedback does to one session's sender, beyond what aiortc does with it.
+
+- REMB: the browser's bitrate estimate is kept unclamped (`session.remb_bps`) for the adaptation
+  (adapt.py) before aiortc clamps it into the encoder's range.
+- NACK of packets that cannot help any more: aiortc resends whatever the NACK names that is in its
+  last 128 packets. After an outage (the radio's 3 s) the browser names every packet it missed:
+  over a hundred, seconds old, a burst of ~150 kB that on a 500 kbit/s radio with a 64 kB buffer
+  clogs the link for seconds, loses part of itself and delays the fresh frames behind it, while
+  the picture still cannot be decoded (a packet older than the history is gone, and every VP8
+  frame needs the one before). When a NACK names a packet the sender no longer has, or one sent
+  more than MAX_RESEND_AGE_S ago, nothing is resent and the next frame is a keyframe instead (at
+  most one such keyframe per KEYFRAME_MIN_INTERVAL_S: the browser repeats its NACKs). The browser
+  then shows a fresh picture about a round trip after the link is back.
+Both wrap the sender's private _handle_rtcp_packet (aiortc is pinned).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+# A resent packet older than this arrives after the browser's jitter buffer has given its frame
+# up (libwebrtc: a few NACK rounds); the radio's deep buffer alone holds about a second.
+MAX_RESEND_AGE_S = 1.5
+KEYFRAME_MIN_INTERVAL_S = 1.0
+_ABS_SEND_TIME_HZ = 1 << 18  # RTP abs-send-time: 6.18 fixed-point seconds, 24 bits
+
+
+def _abs_send_time_now() -> int:
+    from aiortc import clock
+
+    return (clock.current_ntp_time() >> 14) & 0xFFFFFF
+
+
+def can_resend(sender: Any, seq: int, now_abs: int) -> bool:
+    """The packet is in the sender's history, sent at most MAX_RESEND_AGE_S ago."""
+    from aiortc.rtp import RTP_HISTORY_SIZE
+
+    packet = sender._RTCRtpSender__rtp_history.get(seq % RTP_HISTORY_SIZE)
+    if packet is None or packet.sequence_number != seq:
+        return False
+    sent = packet.extensions.abs_send_time
+    return sent is None or ((now_abs - sent) & 0xFFFFFF) / _ABS_SEND_TIME_HZ <= MAX_RESEND_AGE_S
+
+
+def tap_rtcp(session: Any, clock=time.monotonic) -> None:
+    """On a WhepSession whose sender is made: REMB kept, hopeless NACKs turned into a keyframe."""
+    from aiortc.rtp import RTCP_PSFB_APP, RTCP_RTPFB_NACK, RtcpPsfbPacket, RtcpRtpfbPacket, unpack_remb_fci
+
+    sender = session.sender
+    handle = sender._handle_rtcp_packet  # called per RTCP packet by the DTLS transport's router
+    last_keyframe = -float("inf")
+
+    async def _handle(packet) -> None:
+        nonlocal last_keyframe
+        if isinstance(packet, RtcpPsfbPacket) and packet.fmt == RTCP_PSFB_APP:
+            try:
+                bitrate, ssrcs = unpack_remb_fci(packet.fci)
+            except ValueError:
+                bitrate, ssrcs = None, ()
+            if bitrate is not None and sender._ssrc in ssrcs:
+                session.remb_bps = bitrate
+        elif isinstance(packet, RtcpRtpfbPacket) and packet.fmt == RTCP_RTPFB_NACK:
+            now_abs = _abs_send_time_now()
+            if not all(can_resend(sender, seq, now_abs) for seq in packet.lost):
+                if clock() - last_keyframe >= KEYFRAME_MIN_INTERVAL_S:
+                    last_keyframe = clock()
+                    session.loss_keyframes += 1
+                    sender._send_keyframe()
+                return
+        await handle(packet)
+
+    sender._handle_rtcp_packet = _handle

@@ -1,0 +1,104 @@
+"""RTCP feedback on a sender: REMB kept; a NACK the sender cannot usefully answer becomes one keyframe."""
+
+import asyncio
+from types import SimpleNamespace
+
+import pytest
+from aiortc.rtp import (
+    RTCP_PSFB_APP,
+    RTCP_RTPFB_NACK,
+    RTP_HISTORY_SIZE,
+    RtcpPsfbPacket,
+    RtcpRtpfbPacket,
+    RtpPacket,
+    pack_remb_fci,
+)
+
+from rover_web.camera.webrtc import feedback
+
+SSRC = 1234
+NOW_ABS = 5 << 18  # abs-send-time: 5 s
+
+
+class Sender:
+    """The bits of aiortc's RTCRtpSender that feedback.py touches."""
+
+    def __init__(self):
+        self._ssrc = SSRC
+        self._RTCRtpSender__rtp_history = {}
+        self.handled = []
+        self.keyframes = 0
+
+    async def _handle_rtcp_packet(self, packet):
+        self.handled.append(packet)
+
+    def _send_keyframe(self):
+        self.keyframes += 1
+
+    def sent(self, seq, seconds_ago):
+        packet = RtpPacket(sequence_number=seq)
+        packet.extensions.abs_send_time = (NOW_ABS - round(seconds_ago * (1 << 18))) & 0xFFFFFF
+        self._RTCRtpSender__rtp_history[seq % RTP_HISTORY_SIZE] = packet
+
+
+class Clock:
+    t = 100.0
+
+    def __call__(self):
+        return self.t
+
+
+@pytest.fixture
+def rig(monkeypatch):
+    monkeypatch.setattr(feedback, "_abs_send_time_now", lambda: NOW_ABS)
+    sender, clock = Sender(), Clock()
+    session = SimpleNamespace(sender=sender, remb_bps=None, loss_keyframes=0)
+    feedback.tap_rtcp(session, clock=clock)
+    return session, sender, clock
+
+
+def nack(*lost):
+    return RtcpRtpfbPacket(fmt=RTCP_RTPFB_NACK, ssrc=1, media_ssrc=SSRC, lost=list(lost))
+
+
+def feed(session, packet):
+    asyncio.run(session.sender._handle_rtcp_packet(packet))
+
+
+def test_remb_is_kept_unclamped_and_still_reaches_aiortc(rig):
+    session, sender, _ = rig
+    feed(session, RtcpPsfbPacket(fmt=RTCP_PSFB_APP, ssrc=1, media_ssrc=0, fci=pack_remb_fci(90_000, [SSRC])))
+    assert session.remb_bps == 90_000
+    assert len(sender.handled) == 1
+
+
+def test_a_nack_of_recent_packets_is_resent_by_aiortc(rig):
+    session, sender, _ = rig
+    sender.sent(10, 0.2)
+    sender.sent(11, 0.2)
+    feed(session, nack(10, 11))
+    assert len(sender.handled) == 1 and sender.keyframes == 0
+
+
+@pytest.mark.parametrize("why", ["gone from the history", "too old"])
+def test_a_nack_naming_a_hopeless_packet_resends_nothing_and_asks_for_a_keyframe(rig, why):
+    session, sender, _ = rig
+    sender.sent(11, 0.2)
+    if why == "too old":
+        sender.sent(10, feedback.MAX_RESEND_AGE_S + 0.5)
+    else:
+        sender.sent(10 + RTP_HISTORY_SIZE, 0.1)  # 10's place in the history, taken by a newer packet
+    feed(session, nack(10, 11))
+    assert sender.handled == []
+    assert sender.keyframes == 1 and session.loss_keyframes == 1
+
+
+def test_repeated_hopeless_nacks_make_one_keyframe_per_interval(rig):
+    session, sender, clock = rig
+    for _ in range(5):
+        feed(session, nack(10))
+        clock.t += 0.1
+    assert sender.keyframes == 1
+    clock.t += feedback.KEYFRAME_MIN_INTERVAL_S
+    feed(session, nack(10))
+    assert sender.keyframes == 2 and sender.handled == []
