@@ -96,7 +96,7 @@ def handle_frame(controller: TeleopController, session: Session, data, max_bytes
             controller.drive(session, frame_.linear, frame_.angular, epoch=frame_.epoch, source=frame_.source,
                              seq=frame_.seq, sent_ms=frame_.t)
         elif isinstance(frame_, Control) and frame_.action == "stop":
-            controller.stop(session, "operator")
+            controller.stop(session, "operator", seq=frame_.seq)
         elif frame_.action == "takeover":
             controller.takeover(session)
         elif frame_.action == "release":

@@ -40,8 +40,11 @@ function start() {
   let driving = false;         // a drive frame went out since the last stop
   let sentAt = -Infinity;      // when the last drive frame went out (performance.now())
   let periodMs = 25;           // the server's repeat period, 1 / rate_hz
-  let seq = 0;                 // numbers this socket's drive frames, so the server drops any that come late
+  let seq = 0;                 // numbers this socket's drive and stop frames, so the server drops any that come late
+  let transport = 'websocket'; // or 'datachannel': unordered, and a lost frame is not sent again
+  let stopRepeats = [];        // timers sending the last stop again over the data channel
   const linkFigures = linkView();
+  const STOP_REPEAT_MS = [50, 100, 150];
 
   const clamp = (v) => (Number.isFinite(v) ? Math.max(-1, Math.min(1, v)) : 0);
   const round = (v) => Math.round(clamp(v) * 1000) / 1000;
@@ -88,6 +91,7 @@ function start() {
     if (!cmd || !mayDrive()) return;
     // t: when it left, on this page's monotonic clock; the server measures jitter and stalls from it
     // and dates the frame's freshness from it (docs/teleop.md).
+    cancelStopRepeats();
     seq += 1;
     send({
       linear: round(cmd.linear), angular: round(cmd.angular), epoch, source: cmd.source,
@@ -95,6 +99,26 @@ function start() {
     });
     driving = true;
     sentAt = performance.now();
+  }
+
+  // A stop carries a seq too: a drive frame sent before it but delivered after it (the data channel
+  // keeps no order) is then dropped by the server. Over the channel a lost stop is not sent again,
+  // which would leave the robot to the deadman: it goes out STOP_REPEAT_MS more times with the same
+  // seq. The server acts on the first to arrive and ignores the rest, and any that a newer press
+  // overtook.
+  function sendStop() {
+    cancelStopRepeats();
+    seq += 1;
+    const frame = { stop: true, seq };
+    send(frame);
+    if (transport !== 'datachannel') return;
+    const sock = ws;
+    stopRepeats = STOP_REPEAT_MS.map((ms) => setTimeout(() => { if (ws === sock) send(frame); }, ms));
+  }
+
+  function cancelStopRepeats() {
+    stopRepeats.forEach(clearTimeout);
+    stopRepeats = [];
   }
 
   function stopRepeat() {
@@ -114,7 +138,7 @@ function start() {
   function update() {
     if (!wanted()) {
       stopRepeat();
-      if (driving) send({ stop: true });
+      if (driving) sendStop();
       driving = false;
       return;
     }
@@ -129,7 +153,7 @@ function start() {
     keys.clear();
     gamepad.suppress();
     stopRepeat();
-    if (driving) send({ stop: true });
+    if (driving) sendStop();
     driving = false;
   }
 
@@ -153,7 +177,8 @@ function start() {
       retryMs = 500;
       const link = $('teleop-link');
       link.dataset.state = 'live';
-      link.dataset.transport = m.transport || 'websocket';  // the camera's data channel, when it is up
+      transport = m.transport || 'websocket';
+      link.dataset.transport = transport;  // the camera's data channel, when it is up
       link.textContent = `connected as ${m.name}${m.transport === 'datachannel' ? ' (data channel)' : ''}`;
     }
     if (m.link) linkFigures.show(m.link);
@@ -189,6 +214,8 @@ function start() {
     ws = teleopChannel.socket()
       || new WebSocket(`${scheme}//${location.host}${base}/ws/teleop?name=${encodeURIComponent(operatorName())}`);
     seq = 0;  // a new socket (or data channel) is a new session on the server
+    cancelStopRepeats();  // their seq belongs to the old session
+    transport = 'websocket';  // until the hello says otherwise
     ws.onmessage = (ev) => {
       let m;
       try { m = JSON.parse(ev.data); } catch { return; }

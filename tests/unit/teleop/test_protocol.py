@@ -30,6 +30,14 @@ def test_control_frames(action):
     assert parse_frame(json.dumps({action: True}), MAX) == Control(action)
 
 
+def test_a_stop_may_carry_a_seq_other_controls_may_not():
+    assert parse_frame('{"stop": true, "seq": 9}', MAX) == Control("stop", 9)
+    for bad in ('{"stop": true, "seq": -1}', '{"stop": true, "seq": 1.5}', '{"stop": true, "seq": null}',
+                '{"takeover": true, "seq": 3}', '{"stop": true, "t": 3}'):
+        with pytest.raises(FrameError):
+            parse_frame(bad, MAX)
+
+
 @pytest.mark.parametrize("text, code", [
     ('{"linear": NaN, "angular": 0}', "non_finite"),
     ('{"linear": Infinity, "angular": 0}', "non_finite"),
@@ -60,7 +68,7 @@ def test_control_frames(action):
     ('{"linear": 0, "angular": 0, "t": 1e300}', "out_of_range"),
     ('{"linear": 0, "angular": 0, "t": NaN}', "non_finite"),
     ('{"linear": 0, "angular": 0, "t": 1e400}', "non_finite"),
-    ('{"stop": true, "seq": 3}', "unknown_field"),
+    ('{"release": true, "seq": 3}', "unknown_field"),
     ('{"stop": false}', "bad_value"),
     ('{"stop": true, "linear": 1}', "unknown_field"),
     ('[0.5, 0.5]', "bad_frame"),
