@@ -10,6 +10,8 @@ Client -> server, one JSON object per text frame:
   {"takeover": true}    take control from whoever holds it
   {"release": true}     give control back
   {"estop": true}       engage the e-stop (any socket, driving or not): the page's fastest way to stop
+  {"pong": n}           answers the data channel's {"type": "ping", "id": n} (a socket answers its
+                        pings in WebSocket pong frames instead): the link's round trip
 `epoch` (default 0) is the number from the server's latest "hello"/"state" message; `source`
 defaults to "joystick". `seq` (a whole number that grows with every drive frame of the socket) and
 `t` (the client's send time in milliseconds on any clock of its own that does not jump, such as
@@ -62,7 +64,12 @@ class Control(NamedTuple):
     seq: int | None = None  # a stop's place among the socket's drive frames
 
 
+class Pong(NamedTuple):
+    id: int
+
+
 CONTROL_ACTIONS = ("stop", "takeover", "release", "estop")
+PING_ID_MAX = 2**32  # link.py numbers its pings in 4 bytes
 DRIVE_KEYS = {"linear", "angular", "epoch", "source", "seq", "t"}
 WHOLE_MAX = 2**53  # the largest whole number a browser's JSON numbers hold exactly
 
@@ -80,7 +87,7 @@ def _loads(data: str):
         return loads_strict(data)
 
 
-def parse_frame(data: str | bytes, max_bytes: int) -> Drive | Control:
+def parse_frame(data: str | bytes, max_bytes: int) -> Drive | Control | Pong:
     if isinstance(data, (bytes, bytearray)):
         if len(data) > max_bytes:
             raise FrameError("frame_too_large", f"frames are limited to {max_bytes} bytes", CLOSE_MESSAGE_TOO_BIG)
@@ -104,6 +111,12 @@ def parse_frame(data: str | bytes, max_bytes: int) -> Drive | Control:
                 if obj[action] is not True:
                     raise InvalidInput(f"'{action}' must be true", "bad_value")
                 return Control(action, _seq(obj) if "seq" in obj else None)
+        if "pong" in obj:
+            only_keys(obj, {"pong"})
+            number_ = obj["pong"]
+            if isinstance(number_, bool) or not isinstance(number_, int) or not 0 <= number_ < PING_ID_MAX:
+                raise InvalidInput(f"'pong' must be the id of a ping, a whole number below {PING_ID_MAX}", "bad_type")
+            return Pong(number_)
         only_keys(obj, DRIVE_KEYS)
         linear = number(obj, "linear", low=-1.0, high=1.0)
         angular = number(obj, "angular", low=-1.0, high=1.0)

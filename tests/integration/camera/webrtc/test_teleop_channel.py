@@ -126,6 +126,26 @@ def test_a_drive_frame_delivered_after_the_stop_it_preceded_moves_nothing(rig, s
     peer.wait_for("/cmd_vel", is_zero, timeout=5.0)
 
 
+@pytest.mark.parametrize("transport", TRANSPORTS)
+def test_the_link_is_measured_and_reported_every_half_second(rig, stick, transport):
+    """The Drive card's link figures and its too-poor banner come from these `state` frames."""
+    server, peer = rig
+    client = stick(server, transport)
+    drive_at(client, [(0.1, 0.0)] * 10)
+    client.send({"stop": True})
+    reports = []
+
+    def measured(m):
+        if m["type"] == "state" and m["reason"] == "link":
+            reports.append(m)
+        return len(reports) >= 3 and reports[-1]["link"]["rtt_ms"] is not None
+
+    client.wait_for(measured, timeout=15)
+    link = reports[-1]["link"]
+    assert link["quality"] in ("ok", "poor", "too_poor") and link["rtt_ms"] >= 0.0
+    assert {"jitter_ms", "stalls", "lost", "out_of_order"} <= set(link)
+
+
 @pytest.mark.parametrize("how", ["delete", "peer_gone"])
 def test_closing_the_session_mid_drive_stops_at_once_and_frees_control(rig, stick, how):
     server, peer = rig
