@@ -29,6 +29,7 @@ function start() {
   let epoch = 0;
   let inControl = false;
   let holder = null;
+  const closedSessions = new Set();  // ids of this page's sockets that it closed or lost
   let estop = card.dataset.mode === 'estop';
   let keepaliveMs = 100;
   let retryMs = 500;
@@ -85,6 +86,19 @@ function start() {
   }
 
   const mayDrive = () => !estop && (inControl || holder === null);
+  // A holder that is one of this page's own closed sockets holds nothing: the server freed control
+  // when that socket closed. Messages made before the close still name it: the data channel's
+  // hello when the card moves onto the channel (made while the socket still held control), or an
+  // event-stream update that was on its way. Taken at their word, they left a press held across
+  // the move waiting, view-only, for a stream update saying control is free, which a slow stream
+  // brings late and a fast one may bring before the hello, i.e. never after it.
+  const live = (h) => (h && closedSessions.has(h.id) ? null : h);
+  function closed(id) {
+    if (!id) return;
+    closedSessions.add(id);
+    if (closedSessions.size > 16) closedSessions.delete(closedSessions.values().next().value);  // reconnects add up
+    holder = live(holder);
+  }
 
   function sendDrive() {
     const cmd = wanted();
@@ -186,7 +200,7 @@ function start() {
     if (m.type === 'hello' || m.type === 'state') {
       epoch = m.epoch;
       inControl = m.in_control;
-      holder = m.holder;
+      holder = live(m.holder);
       estop = m.estop;
       if (m.reason === 'deadman') message('Stopped: no input reached the server in time.');
       else if (m.reason === 'taken_over' && !inControl) message('Another operator took control.');
@@ -222,6 +236,7 @@ function start() {
       onServerMessage(m);
     };
     ws.onclose = () => {
+      closed(session);
       session = null;
       inControl = false;
       driving = false;
@@ -241,6 +256,7 @@ function start() {
     const old = ws;
     old.onclose = null;
     old.close();  // the server frees control this socket held (and zeroes the robot if it moved)
+    closed(session);
     session = null;
     inControl = false;
     driving = false;
@@ -320,7 +336,7 @@ function start() {
     text('teleop-last-stop', s.last_stop ? s.last_stop.reason.replaceAll('_', ' ') : '—');
     // Who holds control, for display and for claiming a free robot. Whether *this* socket holds it
     // comes from the socket itself: an SSE update can be a little older than the socket's news.
-    if (!inControl) holder = s.holder;
+    if (!inControl) holder = live(s.holder);
     estop = s.estop.engaged;
     render();
   });
