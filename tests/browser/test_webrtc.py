@@ -8,6 +8,7 @@ its other interfaces' too: an init script keeps only 127.0.0.1 candidates in the
 on both ends, so it fails if any other address carried the media.
 """
 
+import json
 import time
 
 import pytest
@@ -278,6 +279,12 @@ HOLD_TELEOP_EVENTS = """
     const held = type === 'teleop' ? (ev) => { if (!window.__holdTeleopEvents) fn.call(this, ev); } : fn;
     return add.call(this, type, held, ...rest);
   };
+  const send = RTCDataChannel.prototype.send;
+  window.__channelSent = [];
+  RTCDataChannel.prototype.send = function (data) {
+    if (this.label === 'teleop') window.__channelSent.push(data);
+    return send.call(this, data);
+  };
   const addOnChannel = RTCDataChannel.prototype.addEventListener;
   RTCDataChannel.prototype.addEventListener = function (type, fn, ...rest) {
     const late = type === 'open' ? (ev) => setTimeout(() => fn.call(this, ev), 500) : fn;
@@ -331,4 +338,11 @@ def test_a_key_held_while_the_drive_card_moves_onto_the_data_channel_keeps_drivi
     assert [lin for t, lin, _ in twists(peer) if t > t_driving and lin > 0]
     page.keyboard.up("KeyW")
     peer.wait_for("/cmd_vel", is_zero, timeout=5.0)
+    # The stop is numbered after the last drive frame, and sent more than once: the channel
+    # neither keeps order nor retransmits.
+    page.wait_for_timeout(400)
+    sent = [json.loads(text) for text in page.evaluate("() => window.__channelSent")]
+    stops = [frame for frame in sent if frame.get("stop")]
+    drives = [frame["seq"] for frame in sent if "linear" in frame]
+    assert len(stops) >= 2 and {frame["seq"] for frame in stops} == {max(drives) + 1}, sent[-8:]
     assert page.watch.console_errors == []
