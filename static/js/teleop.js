@@ -196,7 +196,10 @@ function start() {
       link.textContent = `connected as ${m.name}${m.transport === 'datachannel' ? ' (data channel)' : ''}`;
     }
     if (m.link) linkFigures.show(m.link);
-    if (m.type === 'state' && m.reason === 'link') return;  // the periodic report: nothing changed
+    // The periodic report: nothing changed, unless it names a newer epoch. Over the data channel a
+    // state frame can be lost (no retransmits): a stop notice that never came would leave every
+    // frame of a held press refused as stale. Epochs only grow, so an older report changes nothing.
+    if (m.type === 'state' && m.reason === 'link' && !(m.epoch > epoch)) return;
     if (m.type === 'hello' || m.type === 'state') {
       epoch = m.epoch;
       inControl = m.in_control;

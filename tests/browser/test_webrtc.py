@@ -346,3 +346,53 @@ def test_a_key_held_while_the_drive_card_moves_onto_the_data_channel_keeps_drivi
     drives = [frame["seq"] for frame in sent if "linear" in frame]
     assert len(stops) >= 2 and {frame["seq"] for frame in stops} == {max(drives) + 1}, sent[-8:]
     assert page.watch.console_errors == []
+
+
+# Lost packets on the teleop channel: the page's frames while __holdChannelSends is set, and the
+# server's `state` frames whose reason is in __dropReasons.
+CHANNEL_LOSS = """
+(() => {
+  const send = RTCDataChannel.prototype.send;
+  RTCDataChannel.prototype.send = function (data) {
+    if (this.label === 'teleop' && window.__holdChannelSends) return undefined;
+    return send.call(this, data);
+  };
+  const add = RTCDataChannel.prototype.addEventListener;
+  RTCDataChannel.prototype.addEventListener = function (type, fn, ...rest) {
+    const lossy = type !== 'message' ? fn : (ev) => {
+      let m = null;
+      try { m = JSON.parse(ev.data); } catch { /* not ours */ }
+      if (m && m.type === 'state' && (window.__dropReasons || []).includes(m.reason)) return;
+      fn.call(this, ev);
+    };
+    return add.call(this, type, lossy, ...rest);
+  };
+})();
+"""
+
+
+def test_a_lost_stop_notice_on_the_channel_does_not_lose_a_held_press_for_good(live_server, sim_process,
+                                                                               webrtc_page):
+    """The channel does not retransmit: the `deadman` state that tells the page its new epoch can be
+    lost, and every frame the page sends after it carries the old epoch and is refused. The
+    periodic link report names the epoch too; the page takes it from there."""
+    sim_process()
+    page = webrtc_page
+    page.add_init_script(CHANNEL_LOSS)
+    page.goto(live_server.url + "/")
+    page.wait_for_selector("#teleop-link[data-transport='datachannel']", timeout=30000)
+    page.locator("body").click(position={"x": 5, "y": 5})
+    page.keyboard.down("KeyW")
+
+    def teleop():
+        return requests.get(live_server.url + "/api/teleop", timeout=5).json()
+
+    wait_page(page, lambda: teleop()["moving"], 10, "driving over the data channel")
+    page.evaluate("() => { window.__dropReasons = ['deadman']; window.__holdChannelSends = true; }")
+    wait_page(page, lambda: not teleop()["moving"] and teleop()["last_stop"]["reason"] == "deadman", 10,
+              "the deadman stops the robot while the page's frames are lost")
+    page.evaluate("() => { window.__holdChannelSends = false; }")  # the key is still held
+    wait_page(page, lambda: teleop()["moving"], 10, "the held key drives again once the page knows the epoch")
+    page.keyboard.up("KeyW")
+    wait_page(page, lambda: not teleop()["moving"], 10, "and stops")
+    assert page.watch.console_errors == []
