@@ -131,6 +131,9 @@ class LinkWhep:
 
     def _on_message(self, text) -> None:
         message = json.loads(text)
+        if message.get("type") == "ping":  # answered at once, as the page does: the server measures the link
+            self.channel.send(json.dumps({"pong": message["id"]}))
+            return
         with self.cond:
             self.messages.append(message)
             self.cond.notify_all()

@@ -20,7 +20,9 @@ Rules, all enforced under one lock so no two threads can interleave a stale comm
   The check also runs lazily before every input, so a server that was itself stalled stops first
   and only then looks at the frames that piled up.
 - Order: a frame whose `seq` is not newer than one already seen from its socket is dropped, so
-  a late frame never overrides a newer one.
+  a late frame never overrides a newer one. A stop counts: one with a `seq` fences off every
+  drive frame numbered below it (sent before it, delivered after it over the unordered data
+  channel), and is itself ignored if a newer frame was admitted first.
 - Epochs: every socket session has an epoch, starting at 0, that its motion frames must echo.
   A stop the operator did not ask for (deadman, e-stop, takeover, REST stop) bumps the epoch and
   tells the session. Frames sent before the client heard of the stop carry the old epoch and are
@@ -214,9 +216,13 @@ class TeleopController:
         self.stats["inputs"] += 1
         return command
 
-    def stop(self, session: Session, reason: str = "operator") -> bool:
-        """The holder's own stop (stick released, key up, tab hidden). A viewer's stop is ignored."""
+    def stop(self, session: Session, reason: str = "operator", seq: int | None = None) -> bool:
+        """The holder's own stop (stick released, key up, tab hidden). A viewer's stop is ignored,
+        and so is a stop whose `seq` is older than a frame already admitted (link.fence)."""
         with self._cond:
+            if not session.link.fence(seq):
+                self.stats["stale_stops_dropped"] += 1
+                return False
             self._expire(self._clock())
             session.armed = True  # a stop is the neutral input that re-arms after an e-stop
             session.link.idle()

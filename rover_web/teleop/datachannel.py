@@ -6,6 +6,11 @@ WebSocket's: the same frames parsed and judged by the same `handle_frame` (webso
 controller (control.py): one holder, epochs, deadman, e-stop, re-arm; the same hello and `state`
 frames back. Nothing here decides who may drive.
 
+The link is measured as on the socket, every LINK_S: a channel has no ping frames of its own, so
+the server sends `{"type": "ping", "id": n}` and the page answers `{"pong": n}` (the round trip,
+link.py), then a `state` frame with the link's figures (`reason: "link"`), from which the Drive
+card shows them and says when the link is too poor to drive.
+
 Threads: aiortc calls `on_message` and `close` on its asyncio loop. A frame is judged on one
 teleop thread (`handle`), not on the loop: an e-stop frame engages the latch, which writes the
 database with an fsync, and the loop also carries every viewer's video. Replies and state frames
@@ -20,12 +25,13 @@ from __future__ import annotations
 
 import json
 import logging
+import struct
 from collections.abc import Callable
 from concurrent.futures import Executor
 
 from .control import Session, TeleopController
 from .protocol import FrameError
-from .websocket import handle_frame
+from .websocket import LINK_S, handle_frame
 
 log = logging.getLogger(__name__)
 
@@ -34,7 +40,8 @@ LABEL = "teleop"
 
 class TeleopChannel:
     def __init__(self, channel, controller: TeleopController, name: str | None, hello: dict,
-                 max_frame_bytes: int, *, call_soon: Callable[..., None], pool: Executor):
+                 max_frame_bytes: int, *, call_soon: Callable[..., None], pool: Executor,
+                 call_later: Callable[..., object] | None = None):
         self.channel = channel
         self.controller = controller
         self.max_frame_bytes = max_frame_bytes
@@ -44,8 +51,13 @@ class TeleopChannel:
         self.session: Session = controller.connect(name)
         self.session.wake = lambda: call_soon(self.flush)
         self.frames = 0
+        self._call_later = call_later
+        self._timer = None  # the next link report, while one is due (an asyncio.TimerHandle)
+        self._reporting = False  # a link state is being made on the teleop thread
         self._send({**controller.session_state(self.session, "connected"), "type": "hello",
                     "session": self.session.id, "name": self.session.name, "transport": "datachannel", **hello})
+        if call_later is not None:
+            self._timer = call_later(LINK_S, self._link_tick)
 
     # --- on the loop ---
 
@@ -57,6 +69,22 @@ class TeleopChannel:
             self._pool.submit(self.handle, data)
         except RuntimeError:  # the pool is shut down: the server is stopping
             self.close()
+
+    def _link_tick(self) -> None:
+        self._timer = None
+        if self.closed:
+            return
+        self._send({"type": "ping", "id": struct.unpack("!I", self.session.link.ping())[0]})
+        # The state is made on the teleop thread: it takes the controller's lock, which a frame
+        # may hold, and the loop carries every viewer's video. One at a time, should that thread lag.
+        if not self._reporting:
+            self._reporting = True
+            try:
+                self._pool.submit(self._report_link)
+            except RuntimeError:  # the pool is shut down: the server is stopping
+                self.close()
+                return
+        self._timer = self._call_later(LINK_S, self._link_tick)
 
     def flush(self) -> None:
         outbox = self.session.outbox
@@ -76,6 +104,9 @@ class TeleopChannel:
         if self.closed:
             return
         self.closed = True
+        if self._timer is not None:
+            self._timer.cancel()
+            self._timer = None
         self.session.wake = None
         self.controller.disconnect(self.session)
 
@@ -99,6 +130,13 @@ class TeleopChannel:
         if reply is not None:
             self.session.outbox.append(reply)
             self._call_soon(self.flush)
+
+    def _report_link(self) -> None:
+        self._reporting = False
+        if self.closed:
+            return
+        self.session.outbox.append(self.controller.session_state(self.session, "link"))
+        self._call_soon(self.flush)
 
     def _end(self, message: dict) -> None:
         self._send(message)

@@ -126,6 +126,22 @@ class LinkMeter:
                 base.popleft()
             return max(0.0, transit - base[0][1])
 
+    def fence(self, seq: int | None) -> bool:
+        """A stop frame numbered `seq` has come: no drive frame numbered up to it may be admitted
+        after it, as it was sent before the stop (the data channel is unordered). False if a frame
+        at least as new came first: this stop is older than input already acted on (or a repeat
+        of a stop already seen) and must be ignored. Without a seq the floor stays where it is,
+        at the highest seq seen, which admit() already holds."""
+        if seq is None:
+            return True
+        with self._lock:
+            if self._seq is not None:
+                if seq <= self._seq:
+                    return False
+                self.lost += seq - self._seq - 1
+            self._seq = seq
+            return True
+
     def record(self, sent_ms: float | None, now: float) -> None:
         """The figures of an admitted frame. Kept apart from admit() so the controller can do
         this after it has published: measuring never delays a command."""

@@ -3,10 +3,15 @@
 Client -> server, one JSON object per text frame:
   {"linear": f, "angular": f, "epoch": n, "source": "joystick"|"keyboard"|"gamepad", "seq": n, "t": ms}
                         drive; f in [-1, 1]
-  {"stop": true}        the operator's own stop (stick released, key up, tab hidden)
+  {"stop": true, "seq": n}
+                        the operator's own stop (stick released, key up, tab hidden); `seq`
+                        (optional) numbers it among the drive frames, so that no drive frame sent
+                        before it can act after it (the data channel does not keep order)
   {"takeover": true}    take control from whoever holds it
   {"release": true}     give control back
   {"estop": true}       engage the e-stop (any socket, driving or not): the page's fastest way to stop
+  {"pong": n}           answers the data channel's {"type": "ping", "id": n} (a socket answers its
+                        pings in WebSocket pong frames instead): the link's round trip
 `epoch` (default 0) is the number from the server's latest "hello"/"state" message; `source`
 defaults to "joystick". `seq` (a whole number that grows with every drive frame of the socket) and
 `t` (the client's send time in milliseconds on any clock of its own that does not jump, such as
@@ -56,9 +61,15 @@ class Drive(NamedTuple):  # a tuple: built 40 times a second, and cheaper than a
 
 class Control(NamedTuple):
     action: str  # stop | takeover | release | estop
+    seq: int | None = None  # a stop's place among the socket's drive frames
+
+
+class Pong(NamedTuple):
+    id: int
 
 
 CONTROL_ACTIONS = ("stop", "takeover", "release", "estop")
+PING_ID_MAX = 2**32  # link.py numbers its pings in 4 bytes
 DRIVE_KEYS = {"linear", "angular", "epoch", "source", "seq", "t"}
 WHOLE_MAX = 2**53  # the largest whole number a browser's JSON numbers hold exactly
 
@@ -76,7 +87,7 @@ def _loads(data: str):
         return loads_strict(data)
 
 
-def parse_frame(data: str | bytes, max_bytes: int) -> Drive | Control:
+def parse_frame(data: str | bytes, max_bytes: int) -> Drive | Control | Pong:
     if isinstance(data, (bytes, bytearray)):
         if len(data) > max_bytes:
             raise FrameError("frame_too_large", f"frames are limited to {max_bytes} bytes", CLOSE_MESSAGE_TOO_BIG)
@@ -96,10 +107,16 @@ def parse_frame(data: str | bytes, max_bytes: int) -> Drive | Control:
     try:
         for action in CONTROL_ACTIONS:
             if action in obj:
-                only_keys(obj, {action})
+                only_keys(obj, {action, "seq"} if action == "stop" else {action})
                 if obj[action] is not True:
                     raise InvalidInput(f"'{action}' must be true", "bad_value")
-                return Control(action)
+                return Control(action, _seq(obj) if "seq" in obj else None)
+        if "pong" in obj:
+            only_keys(obj, {"pong"})
+            number_ = obj["pong"]
+            if isinstance(number_, bool) or not isinstance(number_, int) or not 0 <= number_ < PING_ID_MAX:
+                raise InvalidInput(f"'pong' must be the id of a ping, a whole number below {PING_ID_MAX}", "bad_type")
+            return Pong(number_)
         only_keys(obj, DRIVE_KEYS)
         linear = number(obj, "linear", low=-1.0, high=1.0)
         angular = number(obj, "angular", low=-1.0, high=1.0)
@@ -107,13 +124,17 @@ def parse_frame(data: str | bytes, max_bytes: int) -> Drive | Control:
         if isinstance(epoch, bool) or not isinstance(epoch, int) or not 0 <= epoch < WHOLE_MAX:
             raise InvalidInput("'epoch' must be a whole number from the server's last state message", "bad_type")
         source = text(obj, "source", default="joystick", choices=SOURCES)
-        seq = t = None
-        if "seq" in obj:  # null included: absent is the way to send none
-            seq = obj["seq"]
-            if isinstance(seq, bool) or not isinstance(seq, int) or not 0 <= seq < WHOLE_MAX:
-                raise InvalidInput(f"'seq' must be a whole number from 0 to {WHOLE_MAX - 1}", "bad_type")
+        seq = _seq(obj) if "seq" in obj else None  # null included: absent is the way to send none
+        t = None
         if "t" in obj:
             t = number(obj, "t", low=0.0, high=float(WHOLE_MAX))
     except InvalidInput as exc:
         raise FrameError(exc.code, str(exc)) from None
     return Drive(linear, angular, epoch, source, seq, t)
+
+
+def _seq(obj: dict) -> int:
+    seq = obj["seq"]
+    if isinstance(seq, bool) or not isinstance(seq, int) or not 0 <= seq < WHOLE_MAX:
+        raise InvalidInput(f"'seq' must be a whole number from 0 to {WHOLE_MAX - 1}", "bad_type")
+    return seq

@@ -25,11 +25,12 @@ import json
 import logging
 import math
 import socket
+import struct
 import threading
 import time
 
 from .control import Refused, Session, TeleopController
-from .protocol import Control, Drive, FrameError, parse_frame
+from .protocol import Control, Drive, FrameError, Pong, parse_frame
 from .ws_frames import (
     CLOSE_NO_STATUS,
     CLOSE_NORMAL,
@@ -95,8 +96,10 @@ def handle_frame(controller: TeleopController, session: Session, data, max_bytes
         if isinstance(frame_, Drive):
             controller.drive(session, frame_.linear, frame_.angular, epoch=frame_.epoch, source=frame_.source,
                              seq=frame_.seq, sent_ms=frame_.t)
+        elif isinstance(frame_, Pong):
+            session.link.pong(struct.pack("!I", frame_.id))
         elif isinstance(frame_, Control) and frame_.action == "stop":
-            controller.stop(session, "operator")
+            controller.stop(session, "operator", seq=frame_.seq)
         elif frame_.action == "takeover":
             controller.takeover(session)
         elif frame_.action == "release":

@@ -29,6 +29,7 @@ function start() {
   let epoch = 0;
   let inControl = false;
   let holder = null;
+  const closedSessions = new Set();  // ids of this page's sockets that it closed or lost
   let estop = card.dataset.mode === 'estop';
   let keepaliveMs = 100;
   let retryMs = 500;
@@ -40,8 +41,11 @@ function start() {
   let driving = false;         // a drive frame went out since the last stop
   let sentAt = -Infinity;      // when the last drive frame went out (performance.now())
   let periodMs = 25;           // the server's repeat period, 1 / rate_hz
-  let seq = 0;                 // numbers this socket's drive frames, so the server drops any that come late
+  let seq = 0;                 // numbers this socket's drive and stop frames, so the server drops any that come late
+  let transport = 'websocket'; // or 'datachannel': unordered, and a lost frame is not sent again
+  let stopRepeats = [];        // timers sending the last stop again over the data channel
   const linkFigures = linkView();
+  const STOP_REPEAT_MS = [50, 100, 150];
 
   const clamp = (v) => (Number.isFinite(v) ? Math.max(-1, Math.min(1, v)) : 0);
   const round = (v) => Math.round(clamp(v) * 1000) / 1000;
@@ -82,12 +86,26 @@ function start() {
   }
 
   const mayDrive = () => !estop && (inControl || holder === null);
+  // A holder that is one of this page's own closed sockets holds nothing: the server freed control
+  // when that socket closed. Messages made before the close still name it: the data channel's
+  // hello when the card moves onto the channel (made while the socket still held control), or an
+  // event-stream update that was on its way. Taken at their word, they left a press held across
+  // the move waiting, view-only, for a stream update saying control is free, which a slow stream
+  // brings late and a fast one may bring before the hello, i.e. never after it.
+  const live = (h) => (h && closedSessions.has(h.id) ? null : h);
+  function closed(id) {
+    if (!id) return;
+    closedSessions.add(id);
+    if (closedSessions.size > 16) closedSessions.delete(closedSessions.values().next().value);  // reconnects add up
+    holder = live(holder);
+  }
 
   function sendDrive() {
     const cmd = wanted();
     if (!cmd || !mayDrive()) return;
     // t: when it left, on this page's monotonic clock; the server measures jitter and stalls from it
     // and dates the frame's freshness from it (docs/teleop.md).
+    cancelStopRepeats();
     seq += 1;
     send({
       linear: round(cmd.linear), angular: round(cmd.angular), epoch, source: cmd.source,
@@ -95,6 +113,26 @@ function start() {
     });
     driving = true;
     sentAt = performance.now();
+  }
+
+  // A stop carries a seq too: a drive frame sent before it but delivered after it (the data channel
+  // keeps no order) is then dropped by the server. Over the channel a lost stop is not sent again,
+  // which would leave the robot to the deadman: it goes out STOP_REPEAT_MS more times with the same
+  // seq. The server acts on the first to arrive and ignores the rest, and any that a newer press
+  // overtook.
+  function sendStop() {
+    cancelStopRepeats();
+    seq += 1;
+    const frame = { stop: true, seq };
+    send(frame);
+    if (transport !== 'datachannel') return;
+    const sock = ws;
+    stopRepeats = STOP_REPEAT_MS.map((ms) => setTimeout(() => { if (ws === sock) send(frame); }, ms));
+  }
+
+  function cancelStopRepeats() {
+    stopRepeats.forEach(clearTimeout);
+    stopRepeats = [];
   }
 
   function stopRepeat() {
@@ -114,7 +152,7 @@ function start() {
   function update() {
     if (!wanted()) {
       stopRepeat();
-      if (driving) send({ stop: true });
+      if (driving) sendStop();
       driving = false;
       return;
     }
@@ -129,7 +167,7 @@ function start() {
     keys.clear();
     gamepad.suppress();
     stopRepeat();
-    if (driving) send({ stop: true });
+    if (driving) sendStop();
     driving = false;
   }
 
@@ -153,15 +191,19 @@ function start() {
       retryMs = 500;
       const link = $('teleop-link');
       link.dataset.state = 'live';
-      link.dataset.transport = m.transport || 'websocket';  // the camera's data channel, when it is up
+      transport = m.transport || 'websocket';
+      link.dataset.transport = transport;  // the camera's data channel, when it is up
       link.textContent = `connected as ${m.name}${m.transport === 'datachannel' ? ' (data channel)' : ''}`;
     }
     if (m.link) linkFigures.show(m.link);
-    if (m.type === 'state' && m.reason === 'link') return;  // the periodic report: nothing changed
+    // The periodic report: nothing changed, unless it names a newer epoch. Over the data channel a
+    // state frame can be lost (no retransmits): a stop notice that never came would leave every
+    // frame of a held press refused as stale. Epochs only grow, so an older report changes nothing.
+    if (m.type === 'state' && m.reason === 'link' && !(m.epoch > epoch)) return;
     if (m.type === 'hello' || m.type === 'state') {
       epoch = m.epoch;
       inControl = m.in_control;
-      holder = m.holder;
+      holder = live(m.holder);
       estop = m.estop;
       if (m.reason === 'deadman') message('Stopped: no input reached the server in time.');
       else if (m.reason === 'taken_over' && !inControl) message('Another operator took control.');
@@ -189,12 +231,15 @@ function start() {
     ws = teleopChannel.socket()
       || new WebSocket(`${scheme}//${location.host}${base}/ws/teleop?name=${encodeURIComponent(operatorName())}`);
     seq = 0;  // a new socket (or data channel) is a new session on the server
+    cancelStopRepeats();  // their seq belongs to the old session
+    transport = 'websocket';  // until the hello says otherwise
     ws.onmessage = (ev) => {
       let m;
       try { m = JSON.parse(ev.data); } catch { return; }
       onServerMessage(m);
     };
     ws.onclose = () => {
+      closed(session);
       session = null;
       inControl = false;
       driving = false;
@@ -214,6 +259,7 @@ function start() {
     const old = ws;
     old.onclose = null;
     old.close();  // the server frees control this socket held (and zeroes the robot if it moved)
+    closed(session);
     session = null;
     inControl = false;
     driving = false;
@@ -293,7 +339,7 @@ function start() {
     text('teleop-last-stop', s.last_stop ? s.last_stop.reason.replaceAll('_', ' ') : '—');
     // Who holds control, for display and for claiming a free robot. Whether *this* socket holds it
     // comes from the socket itself: an SSE update can be a little older than the socket's news.
-    if (!inControl) holder = s.holder;
+    if (!inControl) holder = live(s.holder);
     estop = s.estop.engaged;
     render();
   });

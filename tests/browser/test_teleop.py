@@ -20,10 +20,11 @@ DEADMAN_S = 5.0
 
 @pytest.fixture
 def rig(live_server_factory, ros_peer):
-    # No WebRTC: these tests drive the card over its WebSocket. With the simulator's camera, the
-    # camera card's WebRTC session would move the card to its data channel whenever it opened,
-    # sometimes in the middle of a press (tests/browser/test_webrtc.py drives over the channel and
-    # back; why a press could be lost in that move is still to be found).
+    # No WebRTC: these tests drive the card over its WebSocket and time its zeros. With the
+    # simulator's camera, the camera card's WebRTC session would move the card to its data channel
+    # whenever it opened, and the move itself zeroes the robot (the socket that held control
+    # closes), sometimes in the middle of a press. The move, a press held across it included, is
+    # tested in tests/browser/test_webrtc.py.
     server = live_server_factory(ROVER_WEB_TELEOP_DEADMAN_S=DEADMAN_S, ROVER_WEB_WEBRTC_MAX_VIEWERS=0)
     peer = ros_peer()
     subscribe_cmd_vel(peer)

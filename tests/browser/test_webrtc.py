@@ -8,6 +8,7 @@ its other interfaces' too: an init script keeps only 127.0.0.1 candidates in the
 on both ends, so it fails if any other address carried the media.
 """
 
+import json
 import time
 
 import pytest
@@ -16,6 +17,7 @@ import requests
 from rover_web.camera.service import CameraStreams
 from rover_web.camera.webrtc.service import WebRtcService
 from tests.conftest import CHROMIUM, PageWatch
+from tests.support.teleop_support import is_zero, subscribe_cmd_vel, twists, warm_up
 
 pytestmark = pytest.mark.browser
 
@@ -264,4 +266,133 @@ def test_the_drive_card_drives_over_the_data_channel_and_back_on_the_websocket(l
                "and stops")
     page.select_option("#camera-transport", "mjpeg")  # the peer connection goes: the WebSocket again
     page.wait_for_selector("#teleop-link[data-transport='websocket']", timeout=30000)
+    assert page.watch.console_errors == []
+
+
+# The stream's `teleop` events are dropped while __holdTeleopEvents is set; the page hears that the
+# teleop channel opened half a second after it did, so the server has made the channel's session
+# (and its hello) before the card closes its socket, as on any link slower than loopback.
+HOLD_TELEOP_EVENTS = """
+(() => {
+  const add = EventSource.prototype.addEventListener;
+  EventSource.prototype.addEventListener = function (type, fn, ...rest) {
+    const held = type === 'teleop' ? (ev) => { if (!window.__holdTeleopEvents) fn.call(this, ev); } : fn;
+    return add.call(this, type, held, ...rest);
+  };
+  const send = RTCDataChannel.prototype.send;
+  window.__channelSent = [];
+  RTCDataChannel.prototype.send = function (data) {
+    if (this.label === 'teleop') window.__channelSent.push(data);
+    return send.call(this, data);
+  };
+  const addOnChannel = RTCDataChannel.prototype.addEventListener;
+  RTCDataChannel.prototype.addEventListener = function (type, fn, ...rest) {
+    const late = type === 'open' ? (ev) => setTimeout(() => fn.call(this, ev), 500) : fn;
+    return addOnChannel.call(this, type, late, ...rest);
+  };
+})();
+"""
+
+
+def test_a_key_held_while_the_drive_card_moves_onto_the_data_channel_keeps_driving(live_server, sim_process,
+                                                                                     ros_peer, webrtc_page):
+    """The move closes the socket (the server zeroes the robot: that socket held control) and
+    opens the channel's session, whose hello was made while the socket still held control, so it
+    names that socket as the holder. The key is still held, so the card must drive again over the
+    channel, without waiting for the event stream to say control is free: here the stream's
+    `teleop` updates are held back during the move, as a stalled TCP link would hold them. (The
+    card once took the hello's holder for someone else's and waited, view-only, for an update
+    that a fast stream sometimes delivered before the hello and a slow one not at all.)"""
+    sim_process()
+    peer = ros_peer()
+    subscribe_cmd_vel(peer)
+    warm_up(peer, live_server.url)
+    page = webrtc_page
+    page.add_init_script("localStorage.setItem('rover_web.camera.transport', 'mjpeg')")  # WebRTC later, on cue
+    page.add_init_script(HOLD_TELEOP_EVENTS)
+    page.goto(live_server.url + "/")
+    page.wait_for_selector("#teleop-link[data-state='live'][data-transport='websocket']", timeout=30000)
+    page.locator("body").click(position={"x": 5, "y": 5})
+    page.keyboard.down("KeyW")
+    state = wait_page(page, lambda: (s := requests.get(live_server.url + "/api/teleop", timeout=5).json())["moving"]
+                      and s, 10, "driving over the WebSocket")
+    socket_holder = state["holder"]["id"]
+    page.evaluate("() => { window.__holdTeleopEvents = true; }")
+    page.evaluate("""() => {
+      const choice = document.getElementById('camera-transport');
+      choice.value = 'webrtc';
+      choice.dispatchEvent(new Event('change'));
+    }""")
+    page.wait_for_selector("#teleop-link[data-transport='datachannel']", timeout=30000)
+
+    def channel_drives():
+        s = requests.get(live_server.url + "/api/teleop", timeout=5).json()
+        return s["moving"] and s["holder"] and s["holder"]["id"] != socket_holder and s
+
+    state = wait_page(page, channel_drives, 10, "the held key drives over the data channel")
+    page.evaluate("() => { window.__holdTeleopEvents = false; }")
+    assert state["last_stop"]["reason"] == "disconnected"  # the socket's stop, then the channel's press
+    t_driving = time.monotonic()
+    page.wait_for_timeout(1000)  # still held: still driving (the server's deadman is 0.3 s)
+    assert channel_drives(), "the press held across the move stopped"
+    assert [lin for t, lin, _ in twists(peer) if t > t_driving and lin > 0]
+    page.keyboard.up("KeyW")
+    peer.wait_for("/cmd_vel", is_zero, timeout=5.0)
+    # The stop is numbered after the last drive frame, and sent more than once: the channel
+    # neither keeps order nor retransmits.
+    page.wait_for_timeout(400)
+    sent = [json.loads(text) for text in page.evaluate("() => window.__channelSent")]
+    stops = [frame for frame in sent if frame.get("stop")]
+    drives = [frame["seq"] for frame in sent if "linear" in frame]
+    assert len(stops) >= 2 and {frame["seq"] for frame in stops} == {max(drives) + 1}, sent[-8:]
+    assert page.watch.console_errors == []
+
+
+# Lost packets on the teleop channel: the page's frames while __holdChannelSends is set, and the
+# server's `state` frames whose reason is in __dropReasons.
+CHANNEL_LOSS = """
+(() => {
+  const send = RTCDataChannel.prototype.send;
+  RTCDataChannel.prototype.send = function (data) {
+    if (this.label === 'teleop' && window.__holdChannelSends) return undefined;
+    return send.call(this, data);
+  };
+  const add = RTCDataChannel.prototype.addEventListener;
+  RTCDataChannel.prototype.addEventListener = function (type, fn, ...rest) {
+    const lossy = type !== 'message' ? fn : (ev) => {
+      let m = null;
+      try { m = JSON.parse(ev.data); } catch { /* not ours */ }
+      if (m && m.type === 'state' && (window.__dropReasons || []).includes(m.reason)) return;
+      fn.call(this, ev);
+    };
+    return add.call(this, type, lossy, ...rest);
+  };
+})();
+"""
+
+
+def test_a_lost_stop_notice_on_the_channel_does_not_lose_a_held_press_for_good(live_server, sim_process,
+                                                                               webrtc_page):
+    """The channel does not retransmit: the `deadman` state that tells the page its new epoch can be
+    lost, and every frame the page sends after it carries the old epoch and is refused. The
+    periodic link report names the epoch too; the page takes it from there."""
+    sim_process()
+    page = webrtc_page
+    page.add_init_script(CHANNEL_LOSS)
+    page.goto(live_server.url + "/")
+    page.wait_for_selector("#teleop-link[data-transport='datachannel']", timeout=30000)
+    page.locator("body").click(position={"x": 5, "y": 5})
+    page.keyboard.down("KeyW")
+
+    def teleop():
+        return requests.get(live_server.url + "/api/teleop", timeout=5).json()
+
+    wait_page(page, lambda: teleop()["moving"], 10, "driving over the data channel")
+    page.evaluate("() => { window.__dropReasons = ['deadman']; window.__holdChannelSends = true; }")
+    wait_page(page, lambda: not teleop()["moving"] and teleop()["last_stop"]["reason"] == "deadman", 10,
+              "the deadman stops the robot while the page's frames are lost")
+    page.evaluate("() => { window.__holdChannelSends = false; }")  # the key is still held
+    wait_page(page, lambda: teleop()["moving"], 10, "the held key drives again once the page knows the epoch")
+    page.keyboard.up("KeyW")
+    wait_page(page, lambda: not teleop()["moving"], 10, "and stops")
     assert page.watch.console_errors == []

@@ -46,6 +46,7 @@ class WhepClient:
         self.channel = None
         self.channel_open = threading.Event()
         self.channel_closed = threading.Event()
+        self.answer_pings = True
         self._cond = threading.Condition()
         self.pc = None
         self.location = None
@@ -88,6 +89,8 @@ class WhepClient:
 
     def _on_message(self, text) -> None:
         message = json.loads(text)
+        if message.get("type") == "ping" and self.answer_pings:  # as the page does: the server's round trip
+            self.channel.send(json.dumps({"pong": message["id"]}))
         message["t"] = time.monotonic()
         with self._cond:
             self.messages.append(message)

@@ -390,7 +390,7 @@ class WebRtcService:
             return
         teleop = self.rover.feature(TeleopService)
         glue = TeleopChannel(channel, teleop.controller, session.user, teleop.hello(), teleop.max_frame_bytes,
-                             call_soon=self.loop.call_soon, pool=self._teleop)
+                             call_soon=self.loop.call_soon, call_later=self.loop.loop.call_later, pool=self._teleop)
         session.teleop = glue
         channel.on("message", glue.on_message)
         channel.on("close", glue.close)

@@ -46,6 +46,12 @@ export function attachTeleopChannel(dc) {
     dc.addEventListener('message', (ev) => {
       let m;
       try { m = JSON.parse(ev.data); } catch { return; }
+      // The server's measuring ping (a channel has none of its own, as a WebSocket has): answered
+      // here at once, whoever uses the channel, so the round trip is the link's and not the page's.
+      if (m.type === 'ping') {
+        try { dc.send(JSON.stringify({ pong: m.id })); } catch { /* closing */ }
+        return;
+      }
       if (m.type === 'hello') hello = m;
       else if (m.type === 'state' && hello) hello = { ...hello, ...m, type: 'hello' };
       for (const fn of messageListeners) { try { fn(m); } catch { /* see above */ } }

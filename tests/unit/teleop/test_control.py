@@ -432,3 +432,35 @@ def test_a_gamepad_gets_the_deadman_clamps_single_operator_estop_and_rearm_uncha
     # Letting go of enable sends a stop: one zero, control kept.
     ctl.stop(a)
     assert out.last == (0.0, 0.0) and states[-1]["source"] is None and states[-1]["holder"]["name"] == "a"
+
+
+def test_a_stop_with_a_seq_fences_off_older_drive_frames_that_arrive_after_it(rig):
+    """The data channel is unordered: a drive frame sent just before the stop may arrive after it,
+    and must not drive again."""
+    ctl, clock, out, _ = rig
+    session = ctl.connect("a")
+    for seq in (1, 2, 3):
+        ctl.drive(session, 0.2, 0.0, seq=seq)
+    assert ctl.stop(session, "operator", seq=5) is True
+    assert out.last == (0.0, 0.0)
+    with pytest.raises(Refused) as late:
+        ctl.drive(session, 0.2, 0.0, seq=4)  # sent before the stop, delivered after it
+    assert late.value.code == "stale_seq"
+    assert out.last == (0.0, 0.0) and not ctl.state()["moving"]
+    ctl.drive(session, 0.3, 0.0, seq=6)  # input sent after the stop drives
+    assert out.last == (1.5, 0.0)
+
+
+def test_a_stop_older_than_an_admitted_frame_is_ignored(rig):
+    """A repeated (or late) stop that the operator's newer input overtook does not stop that input."""
+    ctl, clock, out, _ = rig
+    session = ctl.connect("a")
+    ctl.drive(session, 0.2, 0.0, seq=1)
+    assert ctl.stop(session, "operator", seq=2) is True
+    ctl.drive(session, 0.4, 0.0, seq=3)
+    assert ctl.stop(session, "operator", seq=2) is False  # the stop's repeat, after the new press
+    assert out.last == (2.0, 0.0) and ctl.state()["moving"]
+    assert ctl.stop(session, "operator") is True  # without a seq (old clients): always a stop
+    assert out.last == (0.0, 0.0)
+    with pytest.raises(Refused):
+        ctl.drive(session, 0.2, 0.0, seq=3)  # the floor stays at the highest seq seen

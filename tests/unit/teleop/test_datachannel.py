@@ -84,3 +84,50 @@ def test_a_frame_a_socket_is_closed_for_closes_the_channel_and_stops(rig):
     settle()
     assert channel.sent[-1]["error"] == "binary_frame"
     assert channel.closed and glue.closed and out.sent[-1] == (0.0, 0.0)
+
+
+def test_the_channel_gets_a_measuring_ping_and_a_link_state_every_link_s():
+    """As the socket does: the Drive card's link figures and its too-poor banner need them."""
+    from rover_web.teleop.datachannel import LINK_S
+
+    controller = TeleopController(Output(), Limits(2.0, 1.0), estop=None)
+    pool = ThreadPoolExecutor(1)
+    soon, later, channel = [], [], Channel()
+    glue = TeleopChannel(channel, controller, "alice", {}, 4096, call_soon=lambda fn, *a: soon.append((fn, a)),
+                         call_later=lambda delay, fn, *a: later.append((delay, fn, a)) or Handle(), pool=pool)
+
+    def settle():
+        pool.submit(lambda: None).result(5)
+        while soon:
+            fn, args = soon.pop(0)
+            fn(*args)
+
+    def tick():
+        delay, fn, args = later.pop(0)
+        assert delay == LINK_S
+        fn(*args)
+        settle()
+    try:
+        tick()
+        ping = next(m for m in channel.sent if m["type"] == "ping")
+        state = next(m for m in channel.sent if m["type"] == "state")
+        assert state["reason"] == "link" and state["link"]["rtt_ms"] is None and "quality" in state["link"]
+        glue.on_message(json.dumps({"pong": ping["id"]}))
+        settle()
+        channel.sent.clear()
+        tick()
+        state = next(m for m in channel.sent if m["type"] == "state")
+        assert state["reason"] == "link" and state["link"]["rtt_ms"] is not None
+        assert len(later) == 1  # one timer at a time
+        glue.close()
+        assert later == [] or Handle.cancelled
+    finally:
+        pool.shutdown()
+        controller.close()
+
+
+class Handle:
+    cancelled = False
+
+    def cancel(self):
+        Handle.cancelled = True

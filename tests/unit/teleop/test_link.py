@@ -178,3 +178,16 @@ def test_a_snapshot_is_plain_json_with_the_fields_the_page_shows(rig):
     snap = meter.snapshot()
     json.dumps(snap, allow_nan=False)
     assert {"rtt_ms", "jitter_ms", "stalls", "last_stall_ms", "quality"} <= set(snap)
+
+
+def test_fence_raises_the_seq_floor_and_refuses_what_is_not_newer():
+    meter = LinkMeter(lambda: 0.0)
+    assert meter.admit(1, None, 0.0) == 0.0
+    assert meter.fence(None) is True   # no seq: the floor is the highest seen already
+    assert meter.admit(1, None, 0.0) is None
+    assert meter.fence(4) is True
+    assert meter.admit(3, None, 0.0) is None and meter.admit(4, None, 0.0) is None
+    assert meter.fence(4) is False     # a repeat of that stop
+    assert meter.admit(5, None, 0.0) == 0.0
+    assert meter.fence(3) is False
+    assert meter.lost == 2             # 2 and 3 never came before the fence at 4

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rover_web.teleop import protocol as teleop_protocol
-from rover_web.teleop.protocol import Control, Drive, FrameError, parse_frame
+from rover_web.teleop.protocol import Control, Drive, FrameError, Pong, parse_frame
 from rover_web.web.validate import loads_strict
 
 MAX = 4096
@@ -28,6 +28,21 @@ def test_drive_frames():
 @pytest.mark.parametrize("action", ["stop", "takeover", "release"])
 def test_control_frames(action):
     assert parse_frame(json.dumps({action: True}), MAX) == Control(action)
+
+
+def test_a_pong_names_the_ping_it_answers():
+    assert parse_frame('{"pong": 7}', MAX) == Pong(7)
+    for bad in ('{"pong": true}', '{"pong": -1}', '{"pong": 4294967296}', '{"pong": 1, "seq": 2}'):
+        with pytest.raises(FrameError):
+            parse_frame(bad, MAX)
+
+
+def test_a_stop_may_carry_a_seq_other_controls_may_not():
+    assert parse_frame('{"stop": true, "seq": 9}', MAX) == Control("stop", 9)
+    for bad in ('{"stop": true, "seq": -1}', '{"stop": true, "seq": 1.5}', '{"stop": true, "seq": null}',
+                '{"takeover": true, "seq": 3}', '{"stop": true, "t": 3}'):
+        with pytest.raises(FrameError):
+            parse_frame(bad, MAX)
 
 
 @pytest.mark.parametrize("text, code", [
@@ -60,7 +75,7 @@ def test_control_frames(action):
     ('{"linear": 0, "angular": 0, "t": 1e300}', "out_of_range"),
     ('{"linear": 0, "angular": 0, "t": NaN}', "non_finite"),
     ('{"linear": 0, "angular": 0, "t": 1e400}', "non_finite"),
-    ('{"stop": true, "seq": 3}', "unknown_field"),
+    ('{"release": true, "seq": 3}', "unknown_field"),
     ('{"stop": false}', "bad_value"),
     ('{"stop": true, "linear": 1}', "unknown_field"),
     ('[0.5, 0.5]', "bad_frame"),

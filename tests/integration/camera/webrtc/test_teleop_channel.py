@@ -104,6 +104,48 @@ def test_estop_frame_stops_refuses_and_needs_rearm_after_release(rig, stick, tra
     client.send({"stop": True})
 
 
+@pytest.mark.parametrize("transport", TRANSPORTS)
+def test_a_drive_frame_delivered_after_the_stop_it_preceded_moves_nothing(rig, stick, transport):
+    """The channel is unordered: a drive frame the page sent just before its stop can arrive after
+    the stop. The stop's seq fences it off; input sent after the stop drives again."""
+    server, peer = rig
+    client = stick(server, transport)
+    for seq in (1, 2, 3):
+        client.drive(0.2, 0.0, seq=seq)
+    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == pytest.approx(1.0), timeout=5.0)
+    client.send({"stop": True, "seq": 5})
+    zero = peer.wait_for("/cmd_vel", is_zero, timeout=5.0)
+    client.drive(0.2, 0.0, seq=4)  # delivered late: sent before the stop
+    assert client.wait_for(lambda m: m["type"] == "error")["error"] == "stale_seq"
+    time.sleep(0.5)
+    assert all(lin == 0.0 and ang == 0.0 for t, lin, ang in twists(peer) if t >= zero["t"])
+    assert not requests.get(server.url + "/api/teleop", timeout=5).json()["moving"]
+    client.drive(0.3, 0.0, seq=6)
+    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == pytest.approx(1.5), timeout=5.0)
+    client.send({"stop": True, "seq": 7})
+    peer.wait_for("/cmd_vel", is_zero, timeout=5.0)
+
+
+@pytest.mark.parametrize("transport", TRANSPORTS)
+def test_the_link_is_measured_and_reported_every_half_second(rig, stick, transport):
+    """The Drive card's link figures and its too-poor banner come from these `state` frames."""
+    server, peer = rig
+    client = stick(server, transport)
+    drive_at(client, [(0.1, 0.0)] * 10)
+    client.send({"stop": True})
+    reports = []
+
+    def measured(m):
+        if m["type"] == "state" and m["reason"] == "link":
+            reports.append(m)
+        return len(reports) >= 3 and reports[-1]["link"]["rtt_ms"] is not None
+
+    client.wait_for(measured, timeout=15)
+    link = reports[-1]["link"]
+    assert link["quality"] in ("ok", "poor", "too_poor") and link["rtt_ms"] >= 0.0
+    assert {"jitter_ms", "stalls", "lost", "out_of_order"} <= set(link)
+
+
 @pytest.mark.parametrize("how", ["delete", "peer_gone"])
 def test_closing_the_session_mid_drive_stops_at_once_and_frees_control(rig, stick, how):
     server, peer = rig
