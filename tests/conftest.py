@@ -154,12 +154,22 @@ def signed_app(app_factory, tmp_path):
 
 
 @pytest.fixture
-def signed_server(live_server_factory, tmp_path):
+def signed_server_factory(live_server_factory, tmp_path):
+    """make(**settings): a live server with sign-in on and those settings (one per test: the users
+    live in one database file); `.tokens[role]` is each user's API token."""
+    def make(**extra):
+        settings, tokens = _signed_settings(tmp_path)
+        server = live_server_factory(**settings, **extra)
+        server.tokens = tokens
+        return server
+
+    return make
+
+
+@pytest.fixture
+def signed_server(signed_server_factory):
     """A live server with sign-in on; `.tokens[role]` is each user's API token."""
-    settings, tokens = _signed_settings(tmp_path)
-    server = live_server_factory(**settings)
-    server.tokens = tokens
-    return server
+    return signed_server_factory()
 
 
 class ServerProcess:

@@ -31,3 +31,8 @@ def add_users(db_path: str | Path, *roles: str) -> dict[str, str]:
 def sign_in(client, name: str, password: str = PASSWORD):
     """Sign a Flask test client (or a requests.Session against a URL) in through the form."""
     return client.post("/login", data={"username": name, "password": password})
+
+
+def bearer(server, role: str) -> dict[str, str]:
+    """The Authorization header of `server.tokens[role]` (the signed_server fixtures)."""
+    return {"Authorization": f"Bearer {server.tokens[role]}"}

@@ -17,7 +17,7 @@ import requests
 import websocket
 
 from rover_web.config import ROOT
-from tests.support.auth import sign_in
+from tests.support.auth import bearer, sign_in
 from tests.support.rospeer import subprocess_env
 from tests.support.teleop_support import TeleopClient, subscribe_cmd_vel, twists, warm_up
 from tests.support.waiting import wait_until
@@ -31,10 +31,6 @@ def rig(signed_server, ros_peer):
     subscribe_cmd_vel(peer)
     warm_up(peer, signed_server.url, headers=bearer(signed_server, "operator"))
     return signed_server, peer
-
-
-def bearer(server, role: str) -> dict:
-    return {"Authorization": f"Bearer {server.tokens[role]}"}
 
 
 def token_id(server, role: str) -> int:

@@ -8,7 +8,7 @@ import requests
 from rover_web.camera.service import CameraStreams
 from rover_web.plot.service import Plots
 from rover_web.topics.service import TopicBrowser
-from tests.support.auth import add_users
+from tests.support.auth import bearer
 from tests.support.teleop_support import TeleopClient
 from tests.support.waiting import wait_until
 
@@ -69,19 +69,8 @@ def test_the_same_site_and_tools_without_the_header_still_open_streams(live_serv
 
 
 @pytest.fixture
-def signed(live_server_factory, tmp_path):
-    def make(**settings):
-        db_path = tmp_path / "shares.sqlite3"
-        tokens = add_users(db_path)
-        server = live_server_factory(ROVER_WEB_AUTH="required", ROVER_WEB_DB_PATH=str(db_path), **settings)
-        server.tokens = tokens
-        return server
-
-    return make
-
-
-def bearer(server, role: str) -> dict:
-    return {"Authorization": f"Bearer {server.tokens[role]}"}
+def signed(signed_server_factory):
+    return signed_server_factory
 
 
 def test_with_sign_in_on_a_signed_in_cross_site_request_is_judged_by_its_role(signed, opened):

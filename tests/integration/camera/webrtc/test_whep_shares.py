@@ -6,7 +6,8 @@ import pytest
 import requests
 
 from rover_web.camera.webrtc.service import WebRtcService
-from tests.support.auth import add_users
+from tests.integration.camera.webrtc.conftest import LOOPBACK_ONLY
+from tests.support.auth import bearer
 from tests.support.teleop_support import TeleopClient
 from tests.support.waiting import wait_until
 from tests.support.whep import WhepRefused
@@ -16,19 +17,8 @@ pytestmark = pytest.mark.ros
 
 
 @pytest.fixture
-def signed_webrtc(webrtc_server, tmp_path):
-    def make(**settings):
-        db_path = tmp_path / "shares.sqlite3"
-        tokens = add_users(db_path)
-        server = webrtc_server(ROVER_WEB_AUTH="required", ROVER_WEB_DB_PATH=str(db_path), **settings)
-        server.tokens = tokens
-        return server
-
-    return make
-
-
-def bearer(server, role: str) -> dict:
-    return {"Authorization": f"Bearer {server.tokens[role]}"}
+def signed_webrtc(signed_server_factory):
+    return lambda **settings: signed_server_factory(**{**LOOPBACK_ONLY, **settings})
 
 
 def refused(whep, server, query: str, headers: dict | None = None) -> dict:
