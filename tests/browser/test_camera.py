@@ -42,8 +42,9 @@ def test_camera_panel_shows_moving_frames_from_the_simulator(live_server, sim_pr
     second = image.screenshot()
     assert first != second  # the pattern moves and the frame counter changes
     assert page.locator("#camera-message").is_hidden()
-    # An endless MJPEG response must not keep other pages' tests from reaching network idle.
-    page.wait_for_load_state("networkidle", timeout=10000)
+    # No network-idle wait here: the card reads the stream with fetch and acknowledges what it
+    # received with a POST per frame or so (acked_stream.js), so the page is idle only in the gaps
+    # (CI once found none for 10 s). A dashboard with no camera stream still reaches it (test_dashboard.py).
     assert page.watch.offhost == [] and page.watch.console_errors == []
 
 
