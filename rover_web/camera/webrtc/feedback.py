@@ -1,7 +1,10 @@
 """What the browser's RTCP feedback does to one session's sender, beyond what aiortc does with it.
 
 - REMB: the browser's bitrate estimate is kept unclamped (`session.remb_bps`) for the adaptation
-  (adapt.py) before aiortc clamps it into the encoder's range.
+  (adapt.py), and the encoder is given only `session.link_share` of it. aiortc gives the encoder
+  the whole estimate: the video then fills the link, and what a stall held back (the video's own
+  frames, the e-stop's answer, events) drains only as fast as the video leaves room, seconds on a
+  radio. The share leaves that room.
 - NACK of packets that cannot help any more: aiortc resends whatever the NACK names that is in its
   last 128 packets. After an outage (the radio's 3 s) the browser names every packet it missed:
   over a hundred, seconds old, a burst of ~150 kB that on a 500 kbit/s radio with a 64 kB buffer
@@ -60,6 +63,11 @@ def tap_rtcp(session: Any, clock=time.monotonic) -> None:
                 bitrate, ssrcs = None, ()
             if bitrate is not None and sender._ssrc in ssrcs:
                 session.remb_bps = bitrate
+                await handle(packet)
+                encoder = getattr(sender, "_RTCRtpSender__encoder", None)
+                if encoder is not None and hasattr(encoder, "target_bitrate"):
+                    encoder.target_bitrate = int(bitrate * session.link_share)  # clamped by the encoder
+                return
         elif isinstance(packet, RtcpRtpfbPacket) and packet.fmt == RTCP_RTPFB_NACK:
             now_abs = _abs_send_time_now()
             if not all(can_resend(sender, seq, now_abs) for seq in packet.lost):

@@ -84,6 +84,7 @@ class WhepSession:
     last_connected: float | None = None
     ended: str | None = None  # why it ended
     remb_bps: int | None = None  # the browser's latest estimate, unclamped
+    link_share: float = 1.0  # of that estimate, what the video may use (ROVER_WEB_WEBRTC_LINK_SHARE)
     loss_keyframes: int = 0  # keyframes sent instead of resending what could not help (feedback.py)
     revocation: Any = None  # its credential's registration (auth/revocation.py), cancelled when it ends
 
@@ -99,8 +100,10 @@ class WhepSession:
         return getattr(encoder, "target_bitrate", None)
 
     def target_bitrate(self) -> int | None:
-        """What the link allows, for the adaptation: the browser's estimate when one came (aiortc's
-        encoder cannot go below its floor, so the estimate says more), else the encoder's target."""
+        """What the link allows, for the adaptation: the browser's whole estimate when one came
+        (aiortc's encoder cannot go below its floor, so the estimate says more; with only the
+        encoder's share of it, wifi-edge stepped down to 18 fps where it carries 30), else the
+        encoder's target."""
         return self.remb_bps if self.remb_bps is not None else self.encoder_bitrate()
 
     def describe(self) -> dict:
@@ -165,6 +168,7 @@ class WebRtcService:
         self.producers_per_client = config["ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT"]
         self.idle_timeout_s = config["ROVER_WEB_WEBRTC_IDLE_TIMEOUT_S"]
         self.max_fps = config["ROVER_WEB_WEBRTC_MAX_FPS"]
+        self.link_share = config["ROVER_WEB_WEBRTC_LINK_SHARE"]
         self.host_addresses = host_addresses(config)
         try:
             self.ice_servers = [parse_ice_server(s) for s in config["ROVER_WEB_WEBRTC_ICE_SERVERS"]]
@@ -367,6 +371,7 @@ class WebRtcService:
             session.track = track
             video[0].direction = "sendonly"
             session.sender = pc.addTrack(track)
+            session.link_share = self.link_share
             tap_rtcp(session)
             try:
                 answer = await pc.createAnswer()

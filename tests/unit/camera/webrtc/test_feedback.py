@@ -12,6 +12,7 @@ from aiortc.rtp import (
     RtcpRtpfbPacket,
     RtpPacket,
     pack_remb_fci,
+    unpack_remb_fci,
 )
 
 from rover_web.camera.webrtc import feedback
@@ -52,7 +53,7 @@ class Clock:
 def rig(monkeypatch):
     monkeypatch.setattr(feedback, "_abs_send_time_now", lambda: NOW_ABS)
     sender, clock = Sender(), Clock()
-    session = SimpleNamespace(sender=sender, remb_bps=None, loss_keyframes=0)
+    session = SimpleNamespace(sender=sender, remb_bps=None, loss_keyframes=0, link_share=1.0)
     feedback.tap_rtcp(session, clock=clock)
     return session, sender, clock
 
@@ -70,6 +71,25 @@ def test_remb_is_kept_unclamped_and_still_reaches_aiortc(rig):
     feed(session, RtcpPsfbPacket(fmt=RTCP_PSFB_APP, ssrc=1, media_ssrc=0, fci=pack_remb_fci(90_000, [SSRC])))
     assert session.remb_bps == 90_000
     assert len(sender.handled) == 1
+
+
+def test_the_encoder_gets_the_link_share_of_the_estimate(rig):
+    from aiortc.codecs.vpx import MAX_BITRATE, MIN_BITRATE, Vp8Encoder
+
+    session, sender, _ = rig
+    session.link_share = 0.75
+    encoder = sender._RTCRtpSender__encoder = Vp8Encoder()
+
+    async def as_aiortc(packet):  # aiortc's own REMB handling: the whole estimate to the encoder
+        bitrate, _ssrcs = unpack_remb_fci(packet.fci)
+        encoder.target_bitrate = bitrate
+
+    sender._handle_rtcp_packet = as_aiortc
+    feedback.tap_rtcp(session)
+    for estimate in (1_000_000, 400_000, 2_400_000):
+        feed(session, RtcpPsfbPacket(fmt=RTCP_PSFB_APP, ssrc=1, media_ssrc=0, fci=pack_remb_fci(estimate, [SSRC])))
+        assert session.remb_bps == estimate
+        assert encoder.target_bitrate == max(MIN_BITRATE, min(int(estimate * 0.75), MAX_BITRATE))
 
 
 def test_a_nack_of_recent_packets_is_resent_by_aiortc(rig):
