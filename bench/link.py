@@ -259,6 +259,7 @@ def run(args) -> dict:
     webrtc = args.video == "webrtc" and args.camera == "on"
     if webrtc:
         extra["ROVER_WEB_WEBRTC_HOST_ADDRESSES"] = "127.0.0.1"  # the answer's one candidate (link_webrtc.py)
+    extra.update(dict(s.split("=", 1) for s in args.set))  # e.g. --set ROVER_WEB_WEBRTC_LINK_SHARE=0.6
     env = ros_env(ROVER_WEB_DB_PATH=os.path.join(scratch.name, "bench.sqlite3"), **extra)
     print(f"# link bench on {machine()}: {link.describe()}; camera {args.camera} ({args.video}), adapt {adapt}, "
           f"teleop over {args.teleop}; "
@@ -465,6 +466,8 @@ def main() -> int:
                         help="sets ROVER_WEB_CAMERA_ADAPT on the app (default: the app's default)")
     parser.add_argument("--seconds", type=float, default=60.0, help="how long the stick is held")
     parser.add_argument("--estops", type=int, default=10, help="e-stop engage/release trials after the hold")
+    parser.add_argument("--set", action="append", default=[], metavar="ROVER_WEB_NAME=VALUE",
+                        help="an app setting for this run (repeatable)")
     parser.add_argument("--seed", type=int, default=1, help="the emulator's random seed (stalls, jitter)")
     flags = parser.add_argument_group("the link", "override the profile's figures, as `flask link-emulator` "
                                       "does; --profile custom starts from a plain 10 Mbit/s link")
