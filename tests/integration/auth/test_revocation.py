@@ -205,6 +205,30 @@ def test_a_topic_echo_ends_when_its_session_signs_out(signed_server, ros_peer, s
     browser.close()
 
 
+
+def test_a_camera_stream_ends_when_its_viewers_role_changes(signed_server):
+    """MJPEG's endless response is a stream of its own (camera/stream.py), revoked like the others."""
+    from tests.support.camera_peer import ImagePublisher
+    from tests.support.mjpeg import MjpegClient
+
+    camera = ImagePublisher("/revoked_cam", width=160, height=120, hz=15)
+    url = signed_server.url + "/stream?topic=/revoked_cam&msg_type=sensor_msgs/msg/Image"
+    viewer = admin_view = None
+    try:
+        viewer = MjpegClient(url, headers=bearer(signed_server, "viewer"))
+        admin_view = MjpegClient(url, headers=bearer(signed_server, "admin"))
+        wait_until(lambda: viewer.count >= 3 and admin_view.count >= 3, 20, "frames on both streams")
+        assert requests.patch(signed_server.url + "/api/users/viewer", json={"role": "operator"},
+                              headers=bearer(signed_server, "admin"), timeout=5).ok
+        assert viewer.closed.wait(CLOSED_WITHIN_S), "the changed viewer's camera stream goes on"
+        seen = admin_view.count
+        wait_until(lambda: admin_view.count > seen + 3, 10, "the admin's stream goes on")
+    finally:
+        for client in (viewer, admin_view):
+            if client is not None:
+                client.close()
+        camera.close()
+
 # --- REST drives: no socket stays open, yet the drive goes on for up to its duration ---
 
 def rest_drive(server, **credentials) -> None:
