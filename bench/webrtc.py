@@ -21,6 +21,7 @@ import subprocess
 import sys
 import time
 
+import browser_jitter
 import numpy as np
 import requests
 from common import (
@@ -116,6 +117,9 @@ class Viewer:
     async def _tap(self) -> None:
         receiver = self.client.pc.getTransceivers()[0].receiver
         count_rtp_payload(receiver, self._count)
+        # Frames to the decoder at their marker bit, as a browser hands them over: aiortc's own
+        # jitter buffer waits for the next frame's first packet, one frame interval more.
+        browser_jitter.install(receiver)
         # Replace the test client's reader: this one decodes to grey and reads the time code.
         if self.client._reader is not None:
             self.client._reader.cancel()
