@@ -4,7 +4,10 @@
   (adapt.py), and the encoder is given only `session.link_share` of it. aiortc gives the encoder
   the whole estimate: the video then fills the link, and what a stall held back (the video's own
   frames, the e-stop's answer, events) drains only as fast as the video leaves room, seconds on a
-  radio. The share leaves that room.
+  radio. The share leaves that room. aiortc's VP8 encoder will not go below 250 kbit/s, half a
+  0.5 Mbit/s radio whatever the share; ENCODER_FLOOR_BPS lowers that floor, so a share set for
+  such a link (0.5) is what the encoder gets: through the radio profile the frame age p99 went
+  from about 1 s to 0.61 s (BENCHMARKS.md, 2026-11-27).
 - NACK of packets that cannot help any more: aiortc resends whatever the NACK names that is in its
   last 128 packets. After an outage (the radio's 3 s) the browser names every packet it missed:
   over a hundred, seconds old, a burst of ~150 kB that on a 500 kbit/s radio with a 64 kB buffer
@@ -26,6 +29,7 @@ from typing import Any
 # up (libwebrtc: a few NACK rounds); the radio's deep buffer alone holds about a second.
 MAX_RESEND_AGE_S = 1.5
 KEYFRAME_MIN_INTERVAL_S = 1.0
+ENCODER_FLOOR_BPS = 100_000  # aiortc's VP8 floor is 250 kbit/s; the adaptation steps fps and size down below
 _ABS_SEND_TIME_HZ = 1 << 18  # RTP abs-send-time: 6.18 fixed-point seconds, 24 bits
 
 
@@ -48,8 +52,10 @@ def can_resend(sender: Any, seq: int, now_abs: int) -> bool:
 
 def tap_rtcp(session: Any, clock=time.monotonic) -> None:
     """On a WhepSession whose sender is made: REMB kept, hopeless NACKs turned into a keyframe."""
+    import aiortc.codecs.vpx as vpx
     from aiortc.rtp import RTCP_PSFB_APP, RTCP_RTPFB_NACK, RtcpPsfbPacket, RtcpRtpfbPacket, unpack_remb_fci
 
+    vpx.MIN_BITRATE = min(vpx.MIN_BITRATE, ENCODER_FLOOR_BPS)  # read by the encoder's setter each time
     sender = session.sender
     handle = sender._handle_rtcp_packet  # called per RTCP packet by the DTLS transport's router
     last_keyframe = -float("inf")

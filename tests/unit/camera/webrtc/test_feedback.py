@@ -74,7 +74,7 @@ def test_remb_is_kept_unclamped_and_still_reaches_aiortc(rig):
 
 
 def test_the_encoder_gets_the_link_share_of_the_estimate(rig):
-    from aiortc.codecs.vpx import MAX_BITRATE, MIN_BITRATE, Vp8Encoder
+    from aiortc.codecs.vpx import MAX_BITRATE, Vp8Encoder
 
     session, sender, _ = rig
     session.link_share = 0.75
@@ -89,7 +89,12 @@ def test_the_encoder_gets_the_link_share_of_the_estimate(rig):
     for estimate in (1_000_000, 400_000, 2_400_000):
         feed(session, RtcpPsfbPacket(fmt=RTCP_PSFB_APP, ssrc=1, media_ssrc=0, fci=pack_remb_fci(estimate, [SSRC])))
         assert session.remb_bps == estimate
-        assert encoder.target_bitrate == max(MIN_BITRATE, min(int(estimate * 0.75), MAX_BITRATE))
+        assert encoder.target_bitrate == min(int(estimate * 0.75), MAX_BITRATE)
+    # A 0.5 Mbit/s radio with the share set to 0.5: below aiortc's own floor (250 kbit/s), down to ours.
+    session.link_share = 0.5
+    for estimate, target in ((330_000, 165_000), (150_000, feedback.ENCODER_FLOOR_BPS)):
+        feed(session, RtcpPsfbPacket(fmt=RTCP_PSFB_APP, ssrc=1, media_ssrc=0, fci=pack_remb_fci(estimate, [SSRC])))
+        assert encoder.target_bitrate == target < 250_000
 
 
 def test_a_nack_of_recent_packets_is_resent_by_aiortc(rig):
