@@ -100,7 +100,9 @@ def sign_in(page, base_url, name):
     page.fill("input[name=username]", name)
     page.fill("input[name=password]", PASSWORD)
     page.click("button[type=submit]")
-    page.wait_for_url("**/ros", wait_until="commit")
+    # "load", not "commit": the page's module script (ros.js) wires the buttons; a click before it
+    # ran did nothing, and the parameters never came (CI, twice, on a loaded machine).
+    page.wait_for_url("**/ros", wait_until="load")
 
 
 def admin_graph_ready(server):
