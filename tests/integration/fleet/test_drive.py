@@ -176,12 +176,13 @@ def test_a_robot_s_estop_cancels_its_own_navigation_goal_only(fleet_server, acti
 
     assert post(server.robot["boat"] + "/api/estop", {"engaged": True}).status_code == 200
     nav["boat"].wait("canceled", timeout=5)
-    boat = wait_until(lambda: cancel_outcome(server.robot["boat"]), what="the boat's cancel outcome")
+    # 20 s: a loaded machine's answer may come long after the server canceled (CI once waited 10 s in vain).
+    boat = wait_until(lambda: cancel_outcome(server.robot["boat"]), timeout=20, what="the boat's cancel outcome")
     assert (boat["/boat/navigate_to_pose"]["result"], boat["/boat/navigate_to_pose"]["goals"]) == ("canceled", 1)
     assert "/drone/navigate_to_pose" not in boat
 
     # The drone's goal was left running: its own e-stop still finds it to cancel.
     assert post(server.robot["drone"] + "/api/estop", {"engaged": True}).status_code == 200
     nav["drone"].wait("canceled", timeout=5)
-    drone = wait_until(lambda: cancel_outcome(server.robot["drone"]), what="the drone's cancel outcome")
+    drone = wait_until(lambda: cancel_outcome(server.robot["drone"]), timeout=20, what="the drone's cancel outcome")
     assert (drone["/drone/navigate_to_pose"]["result"], drone["/drone/navigate_to_pose"]["goals"]) == ("canceled", 1)
