@@ -5,6 +5,7 @@ ROVER_WEB_CAMERA_ADAPT=false everything is as before (and the queue does pile up
 
 Rates here are generous bounds over windows of seconds, not timings: the machine is shared."""
 
+import statistics
 import threading
 import time
 
@@ -49,6 +50,17 @@ def window(client, seconds):
     return frames / dt, nbytes / dt, nbytes / max(1, frames)
 
 
+def sample_targets(server, label, seconds):
+    """The viewer's target rate (kbit/s) every 0.2 s over `seconds`, None readings left out."""
+    deadline, seen = time.monotonic() + seconds, []
+    while time.monotonic() < deadline:
+        [viewer] = viewers(server, label)["viewers"]
+        if viewer["target_kbps"] is not None:
+            seen.append(viewer["target_kbps"])
+        time.sleep(0.2)
+    return seen
+
+
 def watch_queue(server, proxy, seconds):
     """The largest server-side send queue of the proxied connection over `seconds` (/proc/net/tcp)."""
     deadline, most = time.monotonic() + seconds, 0
@@ -75,12 +87,15 @@ def test_a_slow_viewer_gets_fewer_smaller_frames_and_a_fast_one_keeps_full_rate(
 
     wait_until(lambda: slow_step() >= 1, 40, "the slow viewer's quality lowered")
     time.sleep(3)  # settle
-    most_queued = []
+    most_queued, targets = [], []
     watcher = threading.Thread(target=lambda: most_queued.append(watch_queue(live_server, proxy, 6)))
+    sampler = threading.Thread(target=lambda: targets.extend(sample_targets(live_server, "slow", 6)))
     watcher.start()
+    sampler.start()
     slow_fps, slow_bps, slow_frame = window(slow, 6)
     fast_fps, fast_bps, fast_frame = window(fast, 2)
     watcher.join()
+    sampler.join()
 
     assert fast_fps > 15  # a 30 Hz camera; the fast viewer is not held back by the slow one
     # Quality and size went down so that frames keep coming (the floor is FPS_FLOOR a second).
@@ -94,10 +109,11 @@ def test_a_slow_viewer_gets_fewer_smaller_frames_and_a_fast_one_keeps_full_rate(
     [fast_report] = viewers(live_server, "fast")["viewers"]
     assert fast_report["step"] == 0 and fast_report["quality"] == 80
     assert (fast_report["width"], fast_report["height"]) == (320, 240)
-    # The target may read None for a moment (a fresh estimate not yet made after the path changed);
-    # the frames above already show the rate held.
-    target = slow_report["target_kbps"]
-    assert slow_report["quality"] < 80 and (target is None or target < 8 * SLOW_BPS * 1.5 / 1000)
+    # The target tracks the link: it probes above it now and then (CI once read 758 kbit/s on this
+    # 320 kbit/s link, between two frames that pushed it back down), so its median over the window
+    # is what is held to the link; it may read None while a fresh estimate is made.
+    assert slow_report["quality"] < 80
+    assert targets and statistics.median(targets) < 8 * SLOW_BPS * 1.5 / 1000, targets
     assert fast_report["fps"] > 15 and 0 < slow_report["kbps"] < 8 * SLOW_BPS * 1.5 / 1000
     # Outputs are shared producers of one ROS subscription: the camera sees a single subscriber.
     producers = live_server.rover.feature(CameraStreams).producers.items()
