@@ -307,7 +307,8 @@ def run(args) -> dict:
         if webrtc:  # what the server's adaptation chose by the end of the hold (asked on loopback, not the link)
             session = requests.get(server.url + "/api/camera/whep", timeout=10).json()["sessions"]
             server_said_video = {k: session[0].get(k) for k in ("level", "width", "height", "fps", "target_bps",
-                                                               "remb_bps", "loss_keyframes")} if session else None
+                                                               "remb_bps", "loss_keyframes",
+                                                               "encoder_restarts")} if session else None
         stick.release()
         twists = sub.since(mark)
         said = dict(ws.heard.counts)
@@ -356,6 +357,11 @@ def run(args) -> dict:
     estop_clear = [d for (t0, t1), d in zip(engage_spans, engage, strict=True)
                    if not any(a < t1 and t0 < b for a, b, _ in windows)]
     event_ages = [age for t, age in events.ages if t_start <= t <= t_end]
+    if args.frames_out:  # every frame's arrival (s into the hold), age and size, and the link's windows
+        with open(args.frames_out, "w") as out:
+            json.dump({"frames": [(round(t - t_start, 3), age, size) for t, age, size in frames],
+                       "windows": [(round(a - t_start, 3), round(b - t_start, 3), kind) for a, b, kind in windows]},
+                      out)
     result = {
         "profile": args.profile,
         "camera": args.camera,
@@ -468,6 +474,7 @@ def main() -> int:
     parser.add_argument("--estops", type=int, default=10, help="e-stop engage/release trials after the hold")
     parser.add_argument("--set", action="append", default=[], metavar="ROVER_WEB_NAME=VALUE",
                         help="an app setting for this run (repeatable)")
+    parser.add_argument("--frames-out", metavar="FILE", help="write every frame's arrival, age and size (JSON)")
     parser.add_argument("--seed", type=int, default=1, help="the emulator's random seed (stalls, jitter)")
     flags = parser.add_argument_group("the link", "override the profile's figures, as `flask link-emulator` "
                                       "does; --profile custom starts from a plain 10 Mbit/s link")

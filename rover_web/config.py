@@ -242,7 +242,8 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("WEBRTC_MAX_FPS", 30.0, "float", "most frames a second a WebRTC viewer is sent", 1, 60),
     Setting("WEBRTC_LINK_SHARE", 0.75, "float",
             "the part of the browser's bandwidth estimate a WebRTC viewer's encoder may use; the rest drains "
-            "what a stall queued and carries the e-stop, teleop and events", 0.2, 1.0),
+            "what a stall queued and carries the e-stop, teleop and events (not below 0.75: the browser never "
+            "estimates more than 1.5 × what arrives, and with less the estimate cannot climb)", 0.75, 1.0),
     Setting("WEBRTC_IDLE_TIMEOUT_S", 15.0, "float",
             "a WebRTC session not connected for this long (never, or lost) is closed", 1, 3600),
     Setting("WEBRTC_ICE_SERVERS", [], "list",

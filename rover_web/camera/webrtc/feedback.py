@@ -1,13 +1,14 @@
 """What the browser's RTCP feedback does to one session's sender, beyond what aiortc does with it.
 
 - REMB: the browser's bitrate estimate is kept unclamped (`session.remb_bps`) for the adaptation
-  (adapt.py), and the encoder is given only `session.link_share` of it. aiortc gives the encoder
-  the whole estimate: the video then fills the link, and what a stall held back (the video's own
-  frames, the e-stop's answer, events) drains only as fast as the video leaves room, seconds on a
-  radio. The share leaves that room. aiortc's VP8 encoder will not go below 250 kbit/s, half a
-  0.5 Mbit/s radio whatever the share; ENCODER_FLOOR_BPS lowers that floor, so a share set for
-  such a link (0.5) is what the encoder gets: through the radio profile the frame age p99 went
-  from about 1 s to 0.61 s (BENCHMARKS.md, 2026-11-27).
+  (adapt.py), and the encoder is given only `session.link_share` of it, in steps (bitrate.py).
+  aiortc gives the encoder the whole estimate: the video then fills the link, and what a stall
+  held back (the video's own frames, the e-stop's answer, events) drains only as fast as the
+  video leaves room. The share leaves that room. It stays above 2/3: the browser never estimates
+  more than 1.5 × what arrives, so with less the estimate, and the video with it, sinks to the
+  floor however good the link (0.5, or a fixed 250 kbit/s reserve, kept wifi-edge at 150 kbit/s).
+  aiortc's VP8 encoder will not go below 250 kbit/s, half a 0.5 Mbit/s radio; ENCODER_FLOOR_BPS
+  lowers that floor (BENCHMARKS.md, 2026-11-27).
 - NACK of packets that cannot help any more: aiortc resends whatever the NACK names that is in its
   last 128 packets. After an outage (the radio's 3 s) the browser names every packet it missed:
   over a hundred, seconds old, a burst of ~150 kB that on a 500 kbit/s radio with a 64 kB buffer
@@ -24,6 +25,8 @@ from __future__ import annotations
 
 import time
 from typing import Any
+
+from .bitrate import START_BPS, EncoderBitrate
 
 # A resent packet older than this arrives after the browser's jitter buffer has given its frame
 # up (libwebrtc: a few NACK rounds); the radio's deep buffer alone holds about a second.
@@ -56,9 +59,11 @@ def tap_rtcp(session: Any, clock=time.monotonic) -> None:
     from aiortc.rtp import RTCP_PSFB_APP, RTCP_RTPFB_NACK, RtcpPsfbPacket, RtcpRtpfbPacket, unpack_remb_fci
 
     vpx.MIN_BITRATE = min(vpx.MIN_BITRATE, ENCODER_FLOOR_BPS)  # read by the encoder's setter each time
+    vpx.DEFAULT_BITRATE = START_BPS  # read when the encoder is made, at the first frame
     sender = session.sender
     handle = sender._handle_rtcp_packet  # called per RTCP packet by the DTLS transport's router
     last_keyframe = -float("inf")
+    steps = EncoderBitrate(clock=clock)
 
     async def _handle(packet) -> None:
         nonlocal last_keyframe
@@ -68,11 +73,16 @@ def tap_rtcp(session: Any, clock=time.monotonic) -> None:
             except ValueError:
                 bitrate, ssrcs = None, ()
             if bitrate is not None and sender._ssrc in ssrcs:
+                # Not passed on: all aiortc does with a REMB is give the encoder the whole estimate,
+                # and the encoder runs in a pool thread that could read it before ours replaced it.
                 session.remb_bps = bitrate
-                await handle(packet)
                 encoder = getattr(sender, "_RTCRtpSender__encoder", None)
                 if encoder is not None and hasattr(encoder, "target_bitrate"):
-                    encoder.target_bitrate = int(bitrate * session.link_share)  # clamped by the encoder
+                    before = encoder.target_bitrate
+                    wanted = int(bitrate * session.link_share)
+                    encoder.target_bitrate = steps.update(wanted)  # clamped by the encoder
+                    if abs(encoder.target_bitrate - before) > 0.1 * before:  # aiortc opens a new encoder
+                        session.encoder_restarts += 1
                 return
         elif isinstance(packet, RtcpRtpfbPacket) and packet.fmt == RTCP_RTPFB_NACK:
             now_abs = _abs_send_time_now()

@@ -86,6 +86,7 @@ class WhepSession:
     remb_bps: int | None = None  # the browser's latest estimate, unclamped
     link_share: float = 1.0  # of that estimate, what the video may use (ROVER_WEB_WEBRTC_LINK_SHARE)
     loss_keyframes: int = 0  # keyframes sent instead of resending what could not help (feedback.py)
+    encoder_restarts: int = 0  # bitrate changes aiortc made a new encoder (and so a keyframe) for
     revocation: Any = None  # its credential's registration (auth/revocation.py), cancelled when it ends
 
     @property
@@ -114,7 +115,7 @@ class WhepSession:
                 "level": out.level if out else None, "width": out.width if out else None,
                 "height": out.height if out else None, "fps": out.fps if out else None,
                 "target_bps": self.encoder_bitrate(), "remb_bps": self.remb_bps,
-                "loss_keyframes": self.loss_keyframes,
+                "loss_keyframes": self.loss_keyframes, "encoder_restarts": self.encoder_restarts,
                 "teleop": self.teleop is not None and not self.teleop.closed,
                 "source_hz": self.producer.arrivals.snapshot(stale_after_s=2.0)["rate_hz"] if self.producer else None,
                 "age_s": round(time.monotonic() - self.created, 1)}

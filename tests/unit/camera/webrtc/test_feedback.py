@@ -12,7 +12,6 @@ from aiortc.rtp import (
     RtcpRtpfbPacket,
     RtpPacket,
     pack_remb_fci,
-    unpack_remb_fci,
 )
 
 from rover_web.camera.webrtc import feedback
@@ -53,7 +52,8 @@ class Clock:
 def rig(monkeypatch):
     monkeypatch.setattr(feedback, "_abs_send_time_now", lambda: NOW_ABS)
     sender, clock = Sender(), Clock()
-    session = SimpleNamespace(sender=sender, remb_bps=None, loss_keyframes=0, link_share=1.0)
+    session = SimpleNamespace(sender=sender, remb_bps=None, loss_keyframes=0, encoder_restarts=0, link_share=1.0,
+                              link_reserve_bps=0)
     feedback.tap_rtcp(session, clock=clock)
     return session, sender, clock
 
@@ -66,35 +66,49 @@ def feed(session, packet):
     asyncio.run(session.sender._handle_rtcp_packet(packet))
 
 
-def test_remb_is_kept_unclamped_and_still_reaches_aiortc(rig):
+def remb(estimate):
+    return RtcpPsfbPacket(fmt=RTCP_PSFB_APP, ssrc=1, media_ssrc=0, fci=pack_remb_fci(estimate, [SSRC]))
+
+
+def test_remb_is_kept_unclamped_and_only_we_set_the_encoder(rig):
     session, sender, _ = rig
-    feed(session, RtcpPsfbPacket(fmt=RTCP_PSFB_APP, ssrc=1, media_ssrc=0, fci=pack_remb_fci(90_000, [SSRC])))
+    feed(session, remb(90_000))
     assert session.remb_bps == 90_000
-    assert len(sender.handled) == 1
+    # aiortc's own handler would give the encoder the whole estimate, racing the encoding thread.
+    assert sender.handled == []
 
 
-def test_the_encoder_gets_the_link_share_of_the_estimate(rig):
-    from aiortc.codecs.vpx import MAX_BITRATE, Vp8Encoder
+def test_the_encoder_gets_the_link_share_of_the_estimate_in_steps(rig):
+    from aiortc.codecs.vpx import Vp8Encoder
 
-    session, sender, _ = rig
+    session, sender, clock = rig
     session.link_share = 0.75
     encoder = sender._RTCRtpSender__encoder = Vp8Encoder()
-
-    async def as_aiortc(packet):  # aiortc's own REMB handling: the whole estimate to the encoder
-        bitrate, _ssrcs = unpack_remb_fci(packet.fci)
-        encoder.target_bitrate = bitrate
-
-    sender._handle_rtcp_packet = as_aiortc
-    feedback.tap_rtcp(session)
-    for estimate in (1_000_000, 400_000, 2_400_000):
-        feed(session, RtcpPsfbPacket(fmt=RTCP_PSFB_APP, ssrc=1, media_ssrc=0, fci=pack_remb_fci(estimate, [SSRC])))
-        assert session.remb_bps == estimate
-        assert encoder.target_bitrate == min(int(estimate * 0.75), MAX_BITRATE)
-    # A 0.5 Mbit/s radio with the share set to 0.5: below aiortc's own floor (250 kbit/s), down to ours.
-    session.link_share = 0.5
-    for estimate, target in ((330_000, 165_000), (150_000, feedback.ENCODER_FLOOR_BPS)):
-        feed(session, RtcpPsfbPacket(fmt=RTCP_PSFB_APP, ssrc=1, media_ssrc=0, fci=pack_remb_fci(estimate, [SSRC])))
-        assert encoder.target_bitrate == target < 250_000
+    assert encoder.target_bitrate == feedback.START_BPS  # aiortc's own default is 500 kbit/s, a whole radio
+    feed(session, remb(1_000_000))
+    assert encoder.target_bitrate == feedback.START_BPS  # climbing waits for the estimate to hold
+    clock.t += 2.5
+    feed(session, remb(1_000_000))
+    assert encoder.target_bitrate == 750_000 and session.encoder_restarts == 1
+    # A few per cent either way, as nearly every REMB moves: the encoder (and its keyframe-free stream) stays.
+    for estimate in (1_040_000, 970_000, 1_080_000, 1_010_000):
+        clock.t += 0.1
+        feed(session, remb(estimate))
+        assert session.remb_bps == estimate and encoder.target_bitrate == 750_000
+    # The link pushed back: down at once.
+    clock.t += 0.1
+    feed(session, remb(400_000))
+    assert encoder.target_bitrate == 300_000 and session.encoder_restarts == 2
+    # It recovers: up only once the estimate has stayed higher for UP_HOLD_S.
+    feed(session, remb(800_000))
+    assert encoder.target_bitrate == 300_000
+    clock.t += 2.5
+    feed(session, remb(800_000))
+    assert encoder.target_bitrate == 600_000 and session.encoder_restarts == 3
+    # Below aiortc's own floor (250 kbit/s), down to ours.
+    clock.t += 0.5
+    feed(session, remb(120_000))
+    assert encoder.target_bitrate == feedback.ENCODER_FLOOR_BPS < 250_000
 
 
 def test_a_nack_of_recent_packets_is_resent_by_aiortc(rig):
