@@ -172,6 +172,12 @@ class EventHub:
         return self._cond
 
     @property
+    def last_change(self) -> tuple[int, str, bytes]:
+        """The newest change as (seq, channel, frame); read it under `lock` with the cursors it is
+        compared to (the Broadcaster's fast path)."""
+        return self._last_change
+
+    @property
     def client_count(self) -> int:
         with self._cond:
             return self._clients
@@ -198,7 +204,7 @@ class Subscription:
     def __init__(self, hub: EventHub, channels: frozenset[str], last_event_id: int | None):
         self._hub = hub
         self.channels = channels
-        self._cursor = 0
+        self.cursor = 0  # the last seq this client has been given (or skipped); the hub's lock guards it
         # Replay only ring events the client missed; conflated values always come as a snapshot.
         self._ring_cursor = last_event_id if last_event_id is not None else None
         self._open = True
@@ -211,7 +217,7 @@ class Subscription:
             if self._ring_cursor is not None:
                 frames += [(seq, frame) for seq, ch, frame in hub._ring
                            if seq > self._ring_cursor and ch in self.channels]
-            self._cursor = hub._seq
+            self.cursor = hub._seq
         frames.sort()
         return b"".join(frame for _, frame in frames)
 
@@ -219,7 +225,7 @@ class Subscription:
         """Frames that changed since the last call, newest value only; b"" on timeout, None once closed."""
         hub = self._hub
         with hub._cond:
-            if hub._seq == self._cursor and not hub._closed:
+            if hub._seq == self.cursor and not hub._closed:
                 hub._cond.wait(timeout_s)
             if hub._closed:
                 return None
@@ -229,13 +235,13 @@ class Subscription:
         """Frames that changed since the last call, without waiting (b"" if nothing changed)."""
         hub = self._hub
         with hub._cond:
-            cursor = self._cursor
+            cursor = self.cursor
             if hub._seq == cursor:
                 return b""
             seq, channel, frame = hub._last_change
             if seq == cursor + 1:
                 # The usual case, one poll per change as it happens: no scan of every channel.
-                self._cursor = seq
+                self.cursor = seq
                 return frame if channel in self.channels else b""
             frames = [(seq, frame) for ch, (seq, frame, _) in hub._latest.items()
                       if seq > cursor and ch in self.channels]
@@ -244,7 +250,7 @@ class Subscription:
                     break
                 if ch in self.channels:
                     frames.append((seq, frame))
-            self._cursor = hub._seq
+            self.cursor = hub._seq
         if len(frames) > 1:
             frames.sort()
         return b"".join(frame for _, frame in frames)
