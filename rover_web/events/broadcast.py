@@ -162,6 +162,7 @@ class Broadcaster:
         try:
             while not self._hub.closed:
                 timeout = max(0.0, next_idle_check - time.monotonic())
+                behind = []  # clients that may have missed changes: their buffer just drained, or new
                 for key, mask in sel.select(timeout):
                     client = key.data
                     if client is None:
@@ -171,16 +172,19 @@ class Broadcaster:
                     elif mask & selectors.EVENT_WRITE:
                         with self._send_lock:
                             data, client.out = client.out, b""
-                            if data:
-                                self._try_send(client, data)
-                self._accept(sel)
-                # Clients whose buffer just drained catch up with the newest values here.
-                with self._hub.lock, self._send_lock:
-                    for client in self._clients.values():
-                        if not client.out and not client.dead:
-                            data = client.sub.poll()
-                            if data:
-                                self._try_send(client, data)
+                            if data and self._try_send(client, data):
+                                behind.append(client)
+                behind += self._accept(sel)
+                # They catch up with the newest values here; every other client was served by
+                # _on_change as each change happened (with 500 viewers, polling them all on every
+                # wake-up of this thread was most of its work).
+                if behind:
+                    with self._hub.lock, self._send_lock:
+                        for client in behind:
+                            if not client.out and not client.dead:
+                                data = client.sub.poll()
+                                if data:
+                                    self._try_send(client, data)
                 now = time.monotonic()
                 if now >= next_idle_check:
                     next_idle_check = now + self._idle_check_s
@@ -206,7 +210,7 @@ class Broadcaster:
         except BlockingIOError:
             pass
 
-    def _accept(self, sel: selectors.BaseSelector) -> None:
+    def _accept(self, sel: selectors.BaseSelector) -> list[_Client]:
         with self._lock:
             incoming = list(self._incoming)
             self._incoming.clear()
@@ -216,6 +220,7 @@ class Broadcaster:
                     self._clients[client.sock.fileno()] = client
             for client in incoming:
                 sel.register(client.sock, selectors.EVENT_READ, client)
+        return incoming
 
     def _reconcile(self, sel: selectors.BaseSelector, writing: set[int]) -> None:
         """Match the selector to each client's state; end the dead ones (outside _send_lock)."""
