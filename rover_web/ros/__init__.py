@@ -11,6 +11,9 @@ class RosUnavailable(RuntimeError):
 
 
 def require_rclpy() -> None:
+    from .generators import without_generators
+
+    without_generators()  # before any message class is imported (generators.py)
     try:
         import rclpy  # noqa: F401
     except ImportError as exc:
