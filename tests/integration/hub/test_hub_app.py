@@ -1,0 +1,57 @@
+"""The hub's app in this process (no robot): its routes described, no ROS imported to build it,
+and its roles those of a robot (tests/integration/hub/test_hub.py has the hub with real robots)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+from openapi_spec_validator import validate
+
+from rover_web.config import ROOT
+from tests.conftest import free_port
+from tests.integration.apidocs.test_openapi import described, routes
+from tests.support.auth import add_users, bearer
+
+
+@pytest.fixture
+def hub_app(app_factory, tmp_path):
+    key = tmp_path / "fleet.key"
+    key.write_text("k" * 64)
+    db = tmp_path / "hub.sqlite3"
+    tokens = add_users(db)
+    app = app_factory(ROVER_WEB_HUB=True, ROVER_WEB_ZENOH_MODE="peer", ROVER_WEB_FLEET_KEY_FILE=str(key),
+                      ROVER_WEB_ZENOH_LISTEN=[f"tcp/127.0.0.1:{free_port()}"], ROVER_WEB_AUTH="required",
+                      ROVER_WEB_DB_PATH=str(db))
+    app.tokens = tokens
+    return app
+
+
+def test_every_hub_route_is_described_and_the_document_is_valid(hub_app):
+    document = hub_app.test_client().get("/api/openapi.json", headers=bearer(hub_app, "viewer")).get_json()
+    assert routes(hub_app) == described(document)
+    validate(document)
+
+
+def test_stop_all_takes_any_signed_in_user_as_on_a_robot(hub_app):
+    client = hub_app.test_client()
+    assert client.post("/api/estop/all", json={}).status_code == 401
+    reply = client.post("/api/estop/all", json={}, headers=bearer(hub_app, "viewer"))
+    assert reply.status_code == 200 and reply.json["robots"] == {} and reply.json["engaged"] is False
+    refused = client.post("/api/estop/all", json={"engaged": False}, headers=bearer(hub_app, "viewer"))
+    assert (refused.status_code, refused.json["error"]) == (400, "release_per_robot")
+
+
+def test_building_a_hub_imports_no_ros(tmp_path):
+    key = tmp_path / "fleet.key"
+    key.write_text("k" * 64)
+    settings = {"TESTING": True, "ROVER_WEB_HUB": True, "ROVER_WEB_ZENOH_MODE": "peer",
+                "ROVER_WEB_FLEET_KEY_FILE": str(key), "ROVER_WEB_ZENOH_LISTEN": [f"tcp/127.0.0.1:{free_port()}"],
+                "ROVER_WEB_DB_PATH": str(tmp_path / "hub.sqlite3"), "ROVER_WEB_SECRET_KEY": "x" * 40,
+                "ROVER_WEB_HOST": "127.0.0.1"}
+    code = (f"import sys; from rover_web import create_app; create_app({settings!r}).extensions['rover_web']"
+            ".shutdown(); print(sorted(m for m in sys.modules if m.split('.')[0] == 'rclpy'))")
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip().splitlines()[-1] == "[]"
