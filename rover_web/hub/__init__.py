@@ -119,18 +119,27 @@ def create(app: Flask, settings: dict, testing: bool) -> Flask:
 
 
 def _stop_with_process(rover: Rover) -> None:
-    """SIGTERM and SIGINT close the Zenoh session, then end the process.
+    """The Zenoh session is closed before the interpreter waits for its threads, however the process ends.
 
-    Closed here, not only at exit: Zenoh runs the subscribers' Python callbacks on threads of its
-    own that are not daemons, and the interpreter waits for those before it runs atexit hooks,
-    so a session left open kept the process alive after SIGTERM. The hub has no robot to stop first."""
+    Zenoh runs the subscribers' Python callbacks on threads of its own that are not daemons, and
+    at exit the interpreter joins those before it runs atexit hooks: with the session still open
+    the process never ended (after SIGTERM, or after `flask run` gave up on a port in use).
+    threading's own exit hooks run before that join (concurrent.futures uses them too); SIGTERM
+    and SIGINT close the session first as well. The hub has no robot to stop first."""
     import atexit
 
-    atexit.register(rover.shutdown)
+    register = getattr(threading, "_register_atexit", None)  # CPython 3.9+; private, hence the fallback
+    try:
+        if register is None:
+            raise RuntimeError("threading._register_atexit is not available")
+        register(rover.shutdown)
+    except RuntimeError:
+        atexit.register(rover.shutdown)
     if threading.current_thread() is not threading.main_thread():
         return
 
     def handler(sig, frame):
+        log.warning("hub: %s: closing the Zenoh session and stopping", signal.Signals(sig).name)
         rover.shutdown()
         if sig == signal.SIGINT:
             raise KeyboardInterrupt

@@ -123,7 +123,8 @@ def test_a_forged_or_replayed_stop_is_refused(hub_rig, zenoh_peer):
 
 
 def test_a_forged_summary_is_ignored(hub_rig, zenoh_peer):
-    wait_until(lambda: hub_rig.heard().get("bravo", {}).get("heard") == "live", timeout=15, what="bravo live")
+    wait_until(lambda: (b := hub_rig.heard().get("bravo", {})).get("heard") == "live" and b["mode"] == "idle",
+               timeout=15, what="bravo live and idle")  # an earlier test's release may still be on its way
     status = lambda: requests.get(hub_rig.hub.url + "/api/status", headers=hub_rig.headers(), timeout=5).json()  # noqa: E731
     before = status()["forged_summaries"]
     forged = signing.signed_summary(OTHER_KEY, FLEET, "bravo", 10**6, {"mode": "driving", "title": "bravo"})
@@ -150,3 +151,20 @@ def test_a_killed_robot_is_lost_and_has_no_answer(hub_rig, tmp_path):
         del hub_rig.robots["charlie"]
         for name in ("alpha", "bravo"):
             hub_rig.release(name)
+
+
+def test_robots_work_alone_while_the_hub_is_down_and_return_to_it(hub_rig):
+    wait_until(lambda: all(hub_rig.heard().get(n, {}).get("heard") == "live" for n in ("alpha", "bravo")),
+               timeout=15, what="both live")
+    assert hub_rig.hub.stop() == 0
+    try:
+        # Each robot's own rover_web goes on as if there were no fleet.
+        for name in ("alpha", "bravo"):
+            url = hub_rig.robots[name].url
+            assert requests.post(url + "/api/estop", json={"engaged": True}, timeout=5).json()["engaged"] is True
+            hub_rig.release(name)
+            assert requests.get(url + "/api/robots", timeout=5).json()["robots"][0]["mode"] == "idle"
+    finally:
+        hub_rig.hub.start()  # the same Zenoh endpoint and database: the robots' sessions reconnect to it
+    wait_until(lambda: all(hub_rig.heard().get(n, {}).get("heard") == "live" for n in ("alpha", "bravo")),
+               timeout=15, what="both live again on the restarted hub")

@@ -3,6 +3,7 @@ and its roles those of a robot (tests/integration/hub/test_hub.py has the hub wi
 
 from __future__ import annotations
 
+import socket
 import subprocess
 import sys
 
@@ -55,3 +56,30 @@ def test_building_a_hub_imports_no_ros(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_a_hub_that_cannot_serve_ends_rather_than_hangs(tmp_path):
+    # Zenoh's callback threads are not daemons: with the session left open, the interpreter waited
+    # for them forever once `flask run` gave up on a port in use.
+    from tests.support.rospeer import subprocess_env
+
+    key = tmp_path / "fleet.key"
+    key.write_text("k" * 64)
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        env = subprocess_env(ROVER_WEB_HUB="true", ROVER_WEB_ZENOH_MODE="peer", ROVER_WEB_FLEET_KEY_FILE=str(key),
+                             ROVER_WEB_ZENOH_LISTEN=f"tcp/127.0.0.1:{free_port()}",
+                             ROVER_WEB_DB_PATH=str(tmp_path / "hub.sqlite3"))
+        proc = subprocess.Popen([sys.executable, "-m", "flask", "--app", "rover_web", "run", "--no-reload",
+                                 "--port", str(taken.getsockname()[1])], cwd=ROOT, env=env,
+                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        try:
+            assert proc.wait(20) == 1
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait(5)
+            output = proc.stdout.read()
+            proc.stdout.close()
+    assert "is in use" in output
