@@ -83,3 +83,15 @@ def test_a_hub_that_cannot_serve_ends_rather_than_hangs(tmp_path):
             output = proc.stdout.read()
             proc.stdout.close()
     assert "is in use" in output
+
+
+def test_the_hub_page_asks_a_browser_to_sign_in_and_shows_the_robots_after(hub_app):
+    from tests.support.auth import sign_in
+
+    client = hub_app.test_client()
+    to_login = client.get("/robots")
+    assert to_login.status_code == 302 and "/login?next=/robots" in to_login.headers["Location"]
+    assert sign_in(client, "viewer").status_code == 303
+    assert client.get("/").headers["Location"].endswith("/robots")
+    page = client.get("/robots")
+    assert page.status_code == 200 and "No robot heard yet." in page.get_data(as_text=True)
