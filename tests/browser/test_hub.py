@@ -77,8 +77,21 @@ def hub(app_factory, tmp_path):
     server.server_close()
 
 
-def test_the_hub_page_shows_a_robot_heard_and_the_answers_of_stop_all(hub, page):
+@pytest.fixture
+def strict_page(browser):
+    """A page with the app's Content-Security-Policy enforced (the shared `page` bypasses it)."""
+    from tests.conftest import PageWatch
+
+    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    page = context.new_page()
+    page.watch = PageWatch(page)
+    yield page
+    context.close()
+
+
+def test_the_hub_page_shows_a_robot_heard_and_the_answers_of_stop_all(hub, strict_page):
     url, robot = hub
+    page = strict_page
     page.goto(url + "/robots")
     row = page.locator("#hub-table tr[data-robot='alpha'][data-heard='live']")
     row.wait_for(timeout=10000)  # from the template, or added by the page's poll without a reload
