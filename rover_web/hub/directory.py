@@ -30,6 +30,13 @@ UNHEARD = {"namespace": None, "kind": "robot", "url": None, "link": "no_data", "
            "position": None, "alerts": []}
 
 
+def web_url(url: object) -> str | None:
+    """The robot's URL if it is one a page may link to: http(s) only, never javascript: or data:."""
+    if isinstance(url, str) and url.lower().startswith(("http://", "https://")) and len(url) <= 2000:
+        return url
+    return None
+
+
 class _Heard:
     def __init__(self, name: str):
         self.name = name
@@ -113,5 +120,6 @@ class Directory:
                 line = {**UNHEARD, "title": heard.name, **(heard.summary or {}), "name": heard.name,
                         "heard": "live" if live else "lost", "alive": heard.alive,
                         "summary_age_s": None if age is None else round(age, 3)}
+                line["url"] = web_url(line.get("url"))
                 lines.append(line)
         return lines

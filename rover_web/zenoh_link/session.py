@@ -62,6 +62,9 @@ def link_settings(settings: dict[str, Any]) -> LinkSettings | None:
         for endpoint in settings[name]:
             if "/" not in endpoint:
                 raise ConfigError(f"{name}: {endpoint!r} is not a Zenoh endpoint such as tcp/192.168.1.5:7447")
+    public_url = settings["ROVER_WEB_PUBLIC_URL"]
+    if public_url is not None and not public_url.lower().startswith(("http://", "https://")):
+        raise ConfigError(f"ROVER_WEB_PUBLIC_URL: {public_url!r} is not an http:// or https:// address")
     if mode == "client" and not settings["ROVER_WEB_ZENOH_CONNECT"] and not settings["ROVER_WEB_ZENOH_CONFIG"]:
         raise ConfigError("ROVER_WEB_ZENOH_CONNECT: client mode needs a router or peer to connect to")
     return LinkSettings(mode, list(settings["ROVER_WEB_ZENOH_CONNECT"]), list(settings["ROVER_WEB_ZENOH_LISTEN"]),

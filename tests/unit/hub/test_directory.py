@@ -63,3 +63,13 @@ def test_an_older_summary_played_again_is_ignored():
     assert d.summary_arrived(KEY_EXPR, summary("estop", NOW + 1))
     assert not d.summary_arrived(KEY_EXPR, old)
     assert d.robots()[0]["mode"] == "estop"
+
+
+def test_only_a_web_address_is_linked():
+    d, _ = directory()
+    payload = signing.signed_summary(KEY, "fleet", "alpha", 1, {"url": "javascript:alert(1)"}, now=NOW)
+    assert d.summary_arrived(KEY_EXPR, payload)
+    assert d.robots()[0]["url"] is None
+    payload = signing.signed_summary(KEY, "fleet", "alpha", 2, {"url": "https://alpha.example.org/"}, now=NOW + 1)
+    assert d.summary_arrived(KEY_EXPR, payload)
+    assert d.robots()[0]["url"] == "https://alpha.example.org/"

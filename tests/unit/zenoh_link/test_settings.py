@@ -29,6 +29,8 @@ def test_bad_values_are_named(tmp_path):
         link_settings(settings(ZENOH_MODE="peer", FLEET_KEY_FILE=str(key), FLEET_NAME="Bad/Name"))
     with pytest.raises(ConfigError, match="ROVER_WEB_ZENOH_CONNECT"):
         link_settings(settings(ZENOH_MODE="peer", FLEET_KEY_FILE=str(key), ZENOH_CONNECT=["127.0.0.1:7447"]))
+    with pytest.raises(ConfigError, match="ROVER_WEB_PUBLIC_URL"):
+        link_settings(settings(ZENOH_MODE="peer", FLEET_KEY_FILE=str(key), PUBLIC_URL="javascript:alert(1)"))
     with pytest.raises(ConfigError, match="client mode needs"):
         link_settings(settings(ZENOH_MODE="client", FLEET_KEY_FILE=str(key)))
     with pytest.raises(ConfigError, match="ROVER_WEB_ZENOH_MODE"):
