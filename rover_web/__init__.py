@@ -58,6 +58,13 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         return app
     if process.is_cli_command_lookup():
         return app  # a CLI command, not a server: no node, no database, no stop-on-exit hooks
+    if settings["ROVER_WEB_HUB"]:
+        from rover_web import hub  # a fleet hub: robots heard over Zenoh, and no ROS at all
+
+        return hub.create(app, settings, testing=app.testing)
+    from rover_web import zenoh_link
+
+    zenoh_link.check_settings(settings)  # Zenoh on without the fleet key: refused before the node starts
 
     require_rclpy()
     from rover_web import (
@@ -116,6 +123,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         plot.init_app(app, graph)  # after topics: plots share its subscriptions
         ros_admin.init_app(app, graph)
         fleet_pages.init_app(app, fleet)  # /robots, /api/robots and /robots/<name>/... for every route
+        zenoh_link.init_app(fleet)  # last: its summaries read every feature; its stop engages the e-stop
     except BaseException:
         # A feature that failed to start may follow others that already started loops and
         # threads: stop them all in order, not just the node under them.

@@ -69,6 +69,32 @@ SETTINGS: tuple[Setting, ...] = (
             "reverse proxies in front of the app whose X-Forwarded-For, -Proto and -Host are believed (Werkzeug's "
             "ProxyFix), so each client keeps its own address; 0: none (a client could forge them); set it only "
             "when nothing but the proxy can reach the app", 0, 10),
+    # --- fleet over Zenoh: robots report to a hub (docs/fleet.md#a-hub-over-zenoh) ---
+    Setting("ZENOH_MODE", "off", "str",
+            "Zenoh link to a fleet hub: off, peer or client (client needs a router or peer in "
+            "ROVER_WEB_ZENOH_CONNECT)", choices=("off", "peer", "client")),
+    Setting("ZENOH_CONNECT", [], "list", "Zenoh endpoints to connect to, e.g. tcp/10.0.0.5:7447"),
+    Setting("ZENOH_LISTEN", [], "list", "Zenoh endpoints to listen on, e.g. tcp/0.0.0.0:7447 (the hub's)"),
+    Setting("ZENOH_CONFIG", None, "optional_str",
+            "a Zenoh JSON5 config file (TLS, access control); ROVER_WEB_ZENOH_MODE, _CONNECT and _LISTEN "
+            "override its mode and endpoints"),
+    Setting("ZENOH_MULTICAST_SCOUTING", False, "bool",
+            "let Zenoh find peers by UDP multicast on the LAN; off: only the endpoints listed are used"),
+    Setting("FLEET_NAME", "fleet", "str",
+            "the fleet's name in Zenoh key expressions (rover_web/<fleet>/<robot>/...): 1-32 of a-z 0-9 _"),
+    Setting("FLEET_KEY_FILE", None, "optional_str",
+            "file holding the fleet's shared secret (at least 32 bytes) that signs summaries and stop commands; "
+            "required when ROVER_WEB_ZENOH_MODE is not off"),
+    Setting("PUBLIC_URL", None, "optional_str",
+            "this rover_web's own address as others reach it (https://boat.example.org:5000), for the hub's links"),
+    Setting("HUB", False, "bool",
+            "serve as a fleet hub: no ROS node, every robot heard over Zenoh on /robots, stop-all to each"),
+    Setting("FLEET_LOST_AFTER_S", 3.0, "float",
+            "the hub shows a robot lost when no summary came for this long (or its liveliness token went)", 1.5, 60),
+    Setting("FLEET_STOP_TIMEOUT_S", 2.0, "float",
+            "how long the hub's stop-all waits for each robot's answer (no_answer after)", 0.1, 30),
+    Setting("FLEET_COMMAND_WINDOW_S", 10.0, "float",
+            "a robot refuses a signed stop whose timestamp is further than this from its clock", 1, 300),
     # --- sign-in and HTTPS ---
     Setting("AUTH", "auto", "str",
             "sign-in: auto (required unless the server listens on loopback only), required, or off",

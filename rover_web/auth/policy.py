@@ -29,7 +29,9 @@ PUBLIC_ENDPOINTS = frozenset({"auth.login_form", "auth.login", "estop.login_esto
 # The WHEP offer and its DELETE only watch the camera; the teleop data channel in a WHEP session is
 # refused unless its user was an operator when the session was made (camera/webrtc/service.py).
 # camera.viewer_ack: a page watching MJPEG says what it has received (camera/acks.py); only watching.
+# hub.estop_all: the fleet hub's stop-all (rover_web/hub) only engages, as estop_all does on a robot.
 ANY_USER_ENDPOINTS = frozenset({"auth.logout", "auth.revoke_my_sessions", "estop.estop_set", "estop.estop_all",
+                                "hub.estop_all",
                                 "camera_webrtc.whep_offer", "camera_webrtc.whep_end", "camera.viewer_ack"})
 ADMIN_ENDPOINT_PREFIX = "auth.admin_"
 ADMIN_ENDPOINTS = frozenset({"ros_admin.api_set_parameter", "ros_admin.api_call_service", "ros_admin.api_send_goal"})

@@ -1,0 +1,168 @@
+"""The fleet hub (issue 31): one hub hearing N robots over Zenoh, and a stop-all to all of them.
+
+    .venv/bin/python bench/hub.py [--robots 100] [--processes 2] [--seconds 20] [--stops 3]
+
+The hub is `ROVER_WEB_HUB=true flask run` in its own process (Zenoh listening on a free
+127.0.0.1 port; multicast scouting off). The robots are light: `--processes` child processes of
+this script, each one Zenoh client session holding its share of the robots, each robot a
+liveliness token, a stop queryable that checks the signed command (rover_web.zenoh_link.signing)
+and answers signed, and a signed summary of the real shape published at 1 Hz (phases spread).
+No ROS and no rover_web in them: the hub's cost is what is measured.
+
+Reported: the hub's CPU (% of one core) over the measured window, with every robot heard;
+the summaries' age on the hub (`summary_age_s` of GET /api/robots, sampled every 0.5 s for every
+robot: how old what an operator sees is; a 1 Hz robot's is 0-1 s by design) p50/p99/max; then
+`--stops` rounds of POST /api/estop/all: the HTTP round trip, the hub's own `took_s` (first
+command sent to last answer in), and how many robots answered engaged.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+import requests
+from common import ROOT, Server, free_port, machine, percentile, ros_env, stop_process
+
+FLEET = "bench"
+
+
+def robot_summary(name: str, engaged: bool) -> dict:
+    """What a rover_web robot publishes (rover_web/zenoh_link/robot.py), with plausible values."""
+    return {"name": name, "namespace": f"/{name}", "kind": "rover", "title": name, "url": None, "link": "ok",
+            "mode": "estop" if engaged else "idle", "operator": None,
+            "speed": {"linear_mps": 0.0, "angular_rps": 0.0}, "battery": {"percent": 80.0, "voltage": 24.1},
+            "estop": {"engaged": engaged, "since": None, "by": None}, "position": {"lng": 8.5, "lat": 47.4},
+            "alerts": []}
+
+
+def child(endpoint: str, key_file: str, names: list[str]) -> None:
+    """One process of simulated robots, until stdin closes."""
+    import zenoh
+
+    from rover_web.zenoh_link import signing
+
+    key = signing.load_key(key_file)
+    config = zenoh.Config()
+    config.insert_json5("mode", '"client"')  # a client listens on nothing: nothing opened beyond the hub link
+    config.insert_json5("scouting/multicast/enabled", "false")
+    config.insert_json5("connect/endpoints", json.dumps([endpoint]))
+    session = zenoh.open(config)
+    engaged = dict.fromkeys(names, False)
+    guards = {name: signing.ReplayGuard(10.0) for name in names}
+
+    def on_stop(name, query):
+        payload = query.payload.to_bytes() if query.payload else b""
+        try:
+            command = guards[name].check(key, FLEET, name, json.loads(payload))
+            engaged[name] = True
+            reply = signing.answer(key, FLEET, name, command["nonce"], "engaged")
+        except (ValueError, signing.CommandRefused) as exc:
+            reply = signing.answer(key, FLEET, name, "", "refused", message=str(exc))
+        query.reply(query.key_expr, json.dumps(reply).encode())
+
+    declared = []
+    publishers = {}
+    for name in names:
+        publishers[name] = session.declare_publisher(f"rover_web/{FLEET}/{name}/summary")
+        declared.append(session.liveliness().declare_token(f"rover_web/{FLEET}/{name}/alive"))
+        declared.append(session.declare_queryable(f"rover_web/{FLEET}/{name}/stop",
+                                                  lambda q, name=name: on_stop(name, q)))
+    done = threading.Event()
+    threading.Thread(target=lambda: (sys.stdin.read(), done.set()), daemon=True).start()
+    print("robots ready", flush=True)
+    seq = 0
+    step = 1.0 / len(names)  # each robot at 1 Hz, their phases spread over the second
+    next_at = time.monotonic()
+    while not done.is_set():
+        seq += 1
+        for name in names:
+            next_at += step
+            delay = next_at - time.monotonic()
+            if delay > 0 and done.wait(delay):
+                break
+            publishers[name].put(signing.signed_summary(key, FLEET, name, seq, robot_summary(name, engaged[name])))
+    for item in declared:
+        item.undeclare()
+    session.close()
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--robots", type=int, default=100)
+    parser.add_argument("--processes", type=int, default=2)
+    parser.add_argument("--seconds", type=float, default=20.0)
+    parser.add_argument("--stops", type=int, default=3)
+    parser.add_argument("--child", nargs=3, metavar=("ENDPOINT", "KEY_FILE", "NAMES"), help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        child(args.child[0], args.child[1], args.child[2].split(","))
+        return
+
+    tmp = tempfile.TemporaryDirectory(prefix="rover_web-bench-hub-")
+    key_file = os.path.join(tmp.name, "fleet.key")
+    with open(key_file, "w") as fh:
+        fh.write(os.urandom(32).hex())
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    hub = Server(ros_env(ROVER_WEB_HUB="true", ROVER_WEB_ZENOH_MODE="peer", ROVER_WEB_ZENOH_LISTEN=endpoint,
+                         ROVER_WEB_FLEET_NAME=FLEET, ROVER_WEB_FLEET_KEY_FILE=key_file))
+    names = [f"r{i:03d}" for i in range(args.robots)]
+    shares = [names[i::args.processes] for i in range(args.processes)]
+    children = [subprocess.Popen([sys.executable, __file__, "--child", endpoint, key_file, ",".join(share)],
+                                 cwd=ROOT, env=ros_env(), stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+                for share in shares if share]
+    try:
+        for proc in children:
+            if "robots ready" not in proc.stdout.readline():
+                raise RuntimeError("a robot process did not start")
+        deadline = time.monotonic() + 30
+        while True:
+            robots = requests.get(hub.url + "/api/robots", timeout=5).json()["robots"]
+            if sum(r["heard"] == "live" for r in robots) == args.robots:
+                break
+            if time.monotonic() > deadline:
+                raise RuntimeError(f"only {sum(r['heard'] == 'live' for r in robots)} robots live after 30 s")
+            time.sleep(0.5)
+        print(f"{machine()}; {args.robots} robots in {len(children)} processes, 1 Hz each, {args.seconds:g} s")
+
+        ages: list[float] = []
+        lost = 0
+        cpu0, t0 = hub.cpu_seconds(), time.monotonic()
+        while time.monotonic() - t0 < args.seconds:
+            for line in requests.get(hub.url + "/api/robots", timeout=5).json()["robots"]:
+                lost += line["heard"] != "live"
+                if line["summary_age_s"] is not None:
+                    ages.append(line["summary_age_s"])
+            time.sleep(0.5)
+        cpu = 100.0 * (hub.cpu_seconds() - cpu0) / (time.monotonic() - t0)
+        print(f"hub CPU {cpu:.1f}% of one core (its GET /api/robots every 0.5 s included); RSS {hub.rss_mb():.0f} MB")
+        print(f"summary age on the hub: p50 {percentile(ages, 50):.3f} s, p99 {percentile(ages, 99):.3f} s, "
+              f"max {max(ages):.3f} s over {len(ages)} samples; lost samples: {lost}")
+
+        for i in range(args.stops):
+            t = time.monotonic()
+            answer = requests.post(hub.url + "/api/estop/all", json={}, timeout=60).json()
+            http_s = time.monotonic() - t
+            engaged = sum(a["result"] == "engaged" for a in answer["robots"].values())
+            print(f"stop-all {i + 1}: HTTP {http_s * 1000:.0f} ms, hub took_s {answer['took_s'] * 1000:.0f} ms, "
+                  f"{engaged}/{args.robots} answered engaged")
+            time.sleep(1.0)
+    finally:
+        for proc in children:
+            try:
+                proc.stdin.close()
+                proc.wait(10)
+            except (OSError, subprocess.TimeoutExpired):
+                stop_process(proc)
+        hub.stop()
+        tmp.cleanup()
+
+
+if __name__ == "__main__":
+    main()
