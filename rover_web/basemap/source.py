@@ -31,6 +31,16 @@ def installed_store(config):
     return None
 
 
+def map_view(config) -> dict:
+    """Where a GPS map opens and what it draws under it, from settings alone (no ROS: the hub's map too)."""
+    return {
+        "place": config["ROVER_WEB_MAP_PLACE_NAME"],
+        "center": [config["ROVER_WEB_MAP_CENTER_LNG"], config["ROVER_WEB_MAP_CENTER_LAT"]],
+        "zoom": config["ROVER_WEB_MAP_ZOOM"],
+        "basemap": basemap(config),
+    }
+
+
 def basemap(config) -> dict | None:
     """What the page's raster source needs, or None when no basemap is installed."""
     store = installed_store(config)

@@ -6,6 +6,7 @@
   POST /api/estop/all   a signed stop to every robot heard; each robot's answer, or no_answer
   GET  /api/status      the hub's own state: fleet, robots heard, dropped forged summaries
   GET  /api/openapi.json  these routes described
+  GET  /tiles/<z>/<x>/<y>  the installed basemap's tiles, for the page's map (rover_web/basemap)
 Sign-in, users, tokens and roles are rover_web/auth's, as on a robot, in the hub's own database.
 
 The hub is no ROS node: create() is called before rover_web imports rclpy, and nothing here
@@ -62,7 +63,7 @@ class FleetHub:
 
 def create(app: Flask, settings: dict, testing: bool) -> Flask:
     """Finish `app` as a hub: sign-in, the Zenoh session, the routes. ConfigError if it cannot serve."""
-    from rover_web import auth
+    from rover_web import auth, basemap
     from rover_web.storage.claim import claim
     from rover_web.storage.db import Database, database_path
 
@@ -112,6 +113,7 @@ def create(app: Flask, settings: dict, testing: bool) -> Flask:
             held.release()
         raise
     app.register_blueprint(routes.bp)
+    basemap.init_app(app, rover)  # the map on /robots draws the same offline basemap as a robot's
     if not testing:
         _stop_with_process(rover)
     log.info("fleet hub for %s: Zenoh %s, listen %s, connect %s", link.fleet, link.mode, link.listen, link.connect)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from flask import Blueprint, current_app, jsonify, redirect, render_template, request
 
 from rover_web.auth import signed_in_name
+from rover_web.basemap.source import map_view
 from rover_web.core.state import current_feature
 from rover_web.web.http import ApiError, json_body
 from rover_web.web.validate import InvalidInput, only_keys, text
@@ -37,7 +38,7 @@ def home():
 
 @bp.get("/robots")
 def robots_page():
-    return render_template("hub.html", state=_state())
+    return render_template("hub.html", state=_state(), map_config=map_view(current_app.config))
 
 
 @bp.get("/api/status")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 
-from rover_web.basemap.source import basemap
+from rover_web.basemap.source import map_view
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
 from rover_web.geofence import GeofenceService, OutsideGeofence
@@ -95,14 +95,7 @@ class WaypointsService:
     # --- views' data ---
 
     def map_config(self) -> dict:
-        config = self.config
-        return {
-            "place": config["ROVER_WEB_MAP_PLACE_NAME"],
-            "center": [config["ROVER_WEB_MAP_CENTER_LNG"], config["ROVER_WEB_MAP_CENTER_LAT"]],
-            "zoom": config["ROVER_WEB_MAP_ZOOM"],
-            "basemap": basemap(config),
-            "max_waypoints": self.store.max_waypoints,
-        }
+        return {**map_view(self.config), "max_waypoints": self.store.max_waypoints}
 
     def panel_context(self) -> dict:
         return {"mission": self.store.mission(), "map": self.map_config(), "fix": self.track.state(),

@@ -1,6 +1,8 @@
 // The fleet hub's page (templates/hub.html): polls GET /api/robots once a second while shown, and
 // "Stop all" posts POST /api/estop/all, then shows each robot's answer (engaged, refused, no_answer).
+// Its map is the fleet page's (static/js/fleet/map.js): each robot with a position, dimmed once lost.
 import { api } from './api.js';
+import { createFleetMap, estopState } from './fleet/map.js';
 
 const table = document.querySelector('#hub-table tbody');
 const lastStop = document.getElementById('hub-last-stop');
@@ -12,9 +14,9 @@ function cell(text) {
   return td;
 }
 
-function estopText(estop) {
-  if (!estop || estop.engaged === null || estop.engaged === undefined) return '—';
-  return estop.engaged ? 'engaged' : 'released';
+function estopText(robot) {
+  const state = estopState(robot);
+  return state === 'unknown' ? '—' : state;
 }
 
 function row(r) {
@@ -32,7 +34,7 @@ function row(r) {
   }
   const battery = r.battery && r.battery.percent != null ? `${r.battery.percent.toFixed(0)} %` : '—';
   const position = r.position ? `${r.position.lat.toFixed(6)}, ${r.position.lng.toFixed(6)}` : '—';
-  tr.append(name, cell(r.heard), cell(r.link), cell(r.mode || '—'), cell(battery), cell(estopText(r.estop)),
+  tr.append(name, cell(r.heard), cell(r.link), cell(r.mode || '—'), cell(battery), cell(estopText(r)),
             cell(position), cell((r.alerts || []).join('; ')));
   return tr;
 }
@@ -56,6 +58,7 @@ async function refresh() {
   try {
     const state = await api('GET', '/api/robots');
     table.replaceChildren(...state.robots.map(row));
+    if (fleetMap) fleetMap.render(state.robots);
     showStop(state.last_stop);
   } catch {
     // The next second tries again; the table keeps what it last showed.
@@ -73,4 +76,9 @@ button.addEventListener('click', async () => {
   }
 });
 
+const fleetMap = createFleetMap(document.getElementById('hub-map'), document.getElementById('hub-map-note'));
+if (fleetMap) {
+  window.roverFleetMap = fleetMap.map;  // for the browser tests and the curious operator's console
+  fleetMap.render(JSON.parse(document.getElementById('hub-state').textContent).robots);
+}
 setInterval(refresh, 1000);

@@ -1,6 +1,7 @@
-"""The fleet hub's page in Chromium: a robot heard over real Zenoh appears, and "Stop all" shows
-its answer. The robot here is a light one in this process (a Zenoh session with a token, signed
-summaries and a stop queryable, as bench/hub.py's); tests/integration/hub has real rover_webs."""
+"""The fleet hub's page in Chromium: a robot heard over real Zenoh appears, in the table and on the
+map (where it dims once lost), and "Stop all" shows its answer. The robot here is a light one in
+this process (a Zenoh session with a token, signed summaries and a stop queryable, as
+bench/hub.py's); tests/integration/hub has real rover_webs."""
 
 from __future__ import annotations
 
@@ -16,10 +17,14 @@ from tests.conftest import free_port
 pytestmark = pytest.mark.browser
 
 KEY = b"k" * 64
+ALPHA_URL = "http://127.0.0.1:9/robots/alpha/"
+ALPHA_AT = {"lng": -82.4501234, "lat": 27.3705678}
 
 
 class LightRobot:
-    """alpha of fleet `fleet`: summaries every 0.3 s until closed; engaged once a stop checks."""
+    """alpha of fleet `fleet`: summaries every 0.3 s until closed; engaged once a stop checks.
+
+    Its summary's position is whatever `position` holds (a robot's comes from its GPS fix)."""
 
     def __init__(self, endpoint: str):
         import zenoh
@@ -30,6 +35,7 @@ class LightRobot:
         config.insert_json5("connect/endpoints", json.dumps([endpoint]))
         self.session = zenoh.open(config)
         self.engaged = False
+        self.position = None
         self.guard = signing.ReplayGuard(10.0)
         self.token = self.session.liveliness().declare_token("rover_web/fleet/alpha/alive")
         self.queryable = self.session.declare_queryable("rover_web/fleet/alpha/stop", self._on_stop)
@@ -47,12 +53,14 @@ class LightRobot:
         seq = 0
         while not self.done.wait(0.3):
             seq += 1
-            summary = {"title": "Alpha", "url": "http://127.0.0.1:9/robots/alpha/", "link": "ok",
+            summary = {"title": "Alpha", "url": ALPHA_URL, "link": "ok",
                        "mode": "estop" if self.engaged else "idle", "estop": {"engaged": self.engaged},
-                       "battery": {"percent": 81.0, "voltage": None}, "position": None, "alerts": []}
+                       "battery": {"percent": 81.0, "voltage": None}, "position": self.position, "alerts": []}
             self.publisher.put(signing.signed_summary(KEY, "fleet", "alpha", seq, summary))
 
     def close(self) -> None:
+        if self.done.is_set():
+            return
         self.done.set()
         self.thread.join(5)
         for declared in (self.publisher, self.queryable, self.token):
@@ -80,9 +88,11 @@ def hub(app_factory, tmp_path):
 @pytest.fixture
 def strict_page(browser):
     """A page with the app's Content-Security-Policy enforced (the shared `page` bypasses it)."""
+    from tests.browser.test_csp import RECORD_VIOLATIONS
     from tests.conftest import PageWatch
 
     context = browser.new_context(viewport={"width": 1280, "height": 900})
+    context.add_init_script(RECORD_VIOLATIONS)
     page = context.new_page()
     page.watch = PageWatch(page)
     yield page
@@ -95,10 +105,43 @@ def test_the_hub_page_shows_a_robot_heard_and_the_answers_of_stop_all(hub, stric
     page.goto(url + "/robots")
     row = page.locator("#hub-table tr[data-robot='alpha'][data-heard='live']")
     row.wait_for(timeout=10000)  # from the template, or added by the page's poll without a reload
-    assert row.locator("a").get_attribute("href") == "http://127.0.0.1:9/robots/alpha/"
+    assert row.locator("a").get_attribute("href") == ALPHA_URL
     assert "81 %" in row.inner_text()
     page.click("#hub-stop-all")
     page.locator("#hub-last-stop li[data-robot='alpha']", has_text="alpha: engaged").wait_for(timeout=10000)
     assert robot.engaged
     page.locator("#hub-table tr[data-robot='alpha']", has_text="engaged").wait_for(timeout=5000)
+    assert page.watch.console_errors == [] and page.watch.offhost == []
+    assert page.evaluate("window.__csp") == []
+
+
+def test_the_hub_map_shows_a_robot_where_it_is_links_it_and_dims_it_once_lost(hub, strict_page):
+    url, robot = hub
+    page = strict_page
+    page.goto(url + "/robots")
+    page.wait_for_selector("#hub-map[data-ready='yes']", timeout=10000)
+    assert page.locator(".fleet-marker").count() == 0  # no position yet: no marker, never one at 0,0
+    robot.position = ALPHA_AT  # as if its GPS got a fix: the page's poll places it, without a reload
+    marker = page.locator(".fleet-marker[data-robot='alpha'][data-heard='live']")
+    marker.wait_for(timeout=5000)
+    assert float(marker.get_attribute("data-lng")) == pytest.approx(ALPHA_AT["lng"])
+    assert float(marker.get_attribute("data-lat")) == pytest.approx(ALPHA_AT["lat"])
+    assert marker.inner_text() == "Alpha"
+    assert marker.get_attribute("data-url") == ALPHA_URL
+    assert marker.is_visible()  # framed on the robot
+
+    # Lost (its Zenoh session ends): kept where it was last seen, dimmed.
+    robot.close()
+    lost = page.locator(".fleet-marker[data-robot='alpha'][data-heard='lost']")
+    lost.wait_for(timeout=5000)
+    dot = "getComputedStyle(document.querySelector('.fleet-marker .fleet-marker-dot')).opacity"
+    assert float(page.evaluate(dot)) < 1
+    assert float(lost.get_attribute("data-lat")) == pytest.approx(ALPHA_AT["lat"])
+
+    assert page.evaluate("window.__csp") == []
+    # A marker opens its robot's own rover_web (answered here: nothing listens on port 9).
+    page.route(ALPHA_URL, lambda route: route.fulfill(status=200, content_type="text/html", body="alpha"))
+    with page.expect_navigation():
+        lost.click()
+    assert page.url == ALPHA_URL
     assert page.watch.console_errors == [] and page.watch.offhost == []

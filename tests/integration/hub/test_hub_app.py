@@ -3,6 +3,8 @@ and its roles those of a robot (tests/integration/hub/test_hub.py has the hub wi
 
 from __future__ import annotations
 
+import json
+import re
 import socket
 import subprocess
 import sys
@@ -95,3 +97,26 @@ def test_the_hub_page_asks_a_browser_to_sign_in_and_shows_the_robots_after(hub_a
     assert client.get("/").headers["Location"].endswith("/robots")
     page = client.get("/robots")
     assert page.status_code == 200 and "No robot heard yet." in page.get_data(as_text=True)
+
+
+def test_the_hub_map_has_the_robots_basemap_and_serves_its_tiles(app_factory, tmp_path):
+    """The hub's map is configured from settings alone (no WaypointsService there), as a robot's is."""
+    from rover_web.basemap.tile_store import FolderTiles
+
+    key = tmp_path / "fleet.key"
+    key.write_text("k" * 64)
+    tile, tiles = b"\x89PNG\r\n\x1a\n" + b"\0" * 16, tmp_path / "tiles"
+    FolderTiles(tiles).put(12, 1110, 1720, tile, "png")
+    FolderTiles(tiles).update_metadata(bounds=[-82.5, 27.3, -82.4, 27.4], minzoom=12, maxzoom=12,
+                                       attribution="© test tiles", source="test")
+    app = app_factory(ROVER_WEB_HUB=True, ROVER_WEB_ZENOH_MODE="peer", ROVER_WEB_FLEET_KEY_FILE=str(key),
+                      ROVER_WEB_ZENOH_LISTEN=[f"tcp/127.0.0.1:{free_port()}"], ROVER_WEB_MAP_TILES=str(tiles),
+                      ROVER_WEB_MAP_CENTER_LNG=-82.45, ROVER_WEB_MAP_CENTER_LAT=27.37, ROVER_WEB_MAP_ZOOM=12)
+    client = app.test_client()
+    page = client.get("/robots").get_data(as_text=True)
+    config = json.loads(re.search(r"data-config='(.*?)'", page).group(1))
+    assert config["center"] == [-82.45, 27.37] and config["zoom"] == 12
+    assert config["basemap"]["tiles"] == ["/tiles/{z}/{x}/{y}"] and config["basemap"]["attribution"] == "© test tiles"
+    served = client.get("/tiles/12/1110/1720")
+    assert served.status_code == 200 and served.mimetype == "image/png" and served.data == tile
+    assert client.get("/tiles/12/0/0").status_code == 404

@@ -1,0 +1,122 @@
+// The fleet's GPS map, shared by the fleet page (fleet.js: the robots of one rover_web) and the hub's
+// page (hub.js: robots heard over Zenoh): one marker per robot with a position, each a link to its
+// own rover_web, framed until the operator moves the map. The page gives it GET /api/robots's robots
+// on each poll. A robot the hub has lost (`heard: 'lost'`) stays where it was last seen, dimmed.
+// Untrusted text (titles) only ever goes through textContent; a URL is followed only if http(s)
+// (a path on this server is too).
+import { createGpsMap, fmtLatLng } from '../gps_map.js';
+
+// 'engaged', 'released', or 'unknown' (a robot the hub has heard no summary from yet).
+export function estopState(robot) {
+  const engaged = robot.estop ? robot.estop.engaged : null;
+  if (engaged === true) return 'engaged';
+  return engaged === false ? 'released' : 'unknown';
+}
+
+// The robot's URL if it leads to a web page: the fleet page's are paths on this server, the hub's
+// another server's http(s) URL; never javascript: or data:.
+function webUrl(url) {
+  if (typeof url !== 'string' || url === '') return null;
+  try {
+    return ['http:', 'https:'].includes(new URL(url, window.location.href).protocol) ? url : null;
+  } catch {
+    return null;
+  }
+}
+
+function markerElement(robot) {
+  const node = document.createElement('button');
+  node.type = 'button';
+  node.className = 'fleet-marker';
+  node.dataset.robot = robot.name;
+  const dot = document.createElement('span');
+  dot.className = 'fleet-marker-dot';
+  const name = document.createElement('span');
+  name.className = 'fleet-marker-name';
+  node.append(dot, name);
+  // A marker is a link to its robot's own rover_web, by mouse, touch or keyboard.
+  node.addEventListener('click', (e) => {
+    e.stopPropagation();
+    if (node.dataset.url) window.location.assign(node.dataset.url);
+  });
+  return node;
+}
+
+function showOnMarker(node, robot) {
+  const url = webUrl(robot.url);
+  const estop = estopState(robot);
+  node.dataset.fix = 'yes';
+  if (url) node.dataset.url = url; else delete node.dataset.url;
+  node.dataset.estop = estop;
+  node.dataset.link = robot.link;
+  if (robot.heard) node.dataset.heard = robot.heard;  // the hub's: live or lost
+  node.dataset.lng = String(robot.position.lng);
+  node.dataset.lat = String(robot.position.lat);
+  node.querySelector('.fleet-marker-name').textContent = robot.title;
+  const lost = robot.heard === 'lost' ? ' · lost: not heard lately' : '';
+  node.title = `${robot.title}: ${robot.mode || '—'}, e-stop ${estop}${lost} · `
+    + `${fmtLatLng(robot.position.lat, robot.position.lng)}${url ? ' · click to open its dashboard' : ''}`;
+  node.setAttribute('aria-label', url ? `${robot.title}: open its dashboard` : robot.title);
+}
+
+// The map in `container` (its data-config: the server's map config), or null when this browser
+// cannot show one: then `note` says so and the page's table goes on alone. render(robots) places
+// every robot; robots given before the map has loaded are placed once it has.
+export function createFleetMap(container, note) {
+  const markers = new Map();  // robot name -> maplibregl.Marker
+  let userMoved = false;  // once the operator pans or zooms, the map stops framing the robots itself
+  let framed = 0;         // how many robots had a position when the map last framed them
+  let ready = false;
+  let latest = [];
+  let map;
+
+  function place(robot) {
+    let marker = markers.get(robot.name);
+    if (!robot.position) {
+      // Kept where it was last known, greyed: never drawn at 0,0.
+      if (marker) marker.getElement().dataset.fix = 'no';
+      return;
+    }
+    if (!marker) {
+      marker = new maplibregl.Marker({ element: markerElement(robot), anchor: 'left', offset: [-9, 0] });
+      marker.setLngLat([robot.position.lng, robot.position.lat]).addTo(map);
+      markers.set(robot.name, marker);
+    }
+    marker.setLngLat([robot.position.lng, robot.position.lat]);
+    showOnMarker(marker.getElement(), robot);
+  }
+
+  // Frame every robot with a position when one more of them has one, until the operator moves the map.
+  function frame(robots) {
+    const placed = robots.filter((r) => r.position);
+    if (userMoved || placed.length <= framed) return;
+    framed = placed.length;
+    const bounds = new maplibregl.LngLatBounds();
+    for (const r of placed) bounds.extend([r.position.lng, r.position.lat]);
+    // More room on the right: each marker's name is drawn there. Less of it all on a small map.
+    const side = Math.min(60, container.clientWidth / 8, container.clientHeight / 8);
+    const padding = { top: side, bottom: side, left: side, right: Math.min(180, container.clientWidth / 3) };
+    map.fitBounds(bounds, { padding, maxZoom: 17, duration: 0 });
+  }
+
+  function render(robots) {
+    latest = robots;
+    if (!ready) return;
+    for (const robot of robots) place(robot);
+    frame(robots);
+  }
+
+  try {
+    map = createGpsMap(container, JSON.parse(container.dataset.config), {
+      onLoad: () => { ready = true; render(latest); },
+    });
+  } catch (err) {
+    note.hidden = false;
+    note.textContent = `The map cannot be shown in this browser (${err.message}); the table still works.`;
+    return null;
+  }
+  for (const start of ['dragstart', 'zoomstart']) {
+    map.on(start, (e) => { if (e.originalEvent) userMoved = true; });
+  }
+  return { map, render };
+}
