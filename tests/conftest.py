@@ -274,11 +274,12 @@ def action_server():
 class SimProcess:
     """`python -m rover_web.sim` (or one part, e.g. module="rover_web.sim.drone") in its own process."""
 
-    def __init__(self, args: list[str], module: str = "rover_web.sim"):
+    def __init__(self, args: list[str], module: str = "rover_web.sim", **env: str):
+        """`env`: variables over the test process's ROS environment (another ROS_DOMAIN_ID, say)."""
         from tests.support.rospeer import subprocess_env
 
         self.proc = subprocess.Popen([sys.executable, "-m", module, *args], cwd=ROOT,
-                                     env=subprocess_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                     env=subprocess_env(**env), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                      text=True)
         line = self.proc.stdout.readline()
         if "simulator running" not in line:

@@ -1,8 +1,9 @@
 """A fleet hub and two robots, each a real process on 127.0.0.1, joined by real Zenoh sessions.
 
 The hub (`ROVER_WEB_HUB=true flask run`) listens for Zenoh on a free loopback port, with sign-in
-required (one user per role); robots alpha and bravo are whole rover_webs (no simulator: their
-summaries need none), each in its own ROS domain, connecting to the hub and listening on a
+required (one user per role); robots alpha and bravo are whole rover_webs, each in its own ROS
+domain with its own simulated rover (`python -m rover_web.sim`: the GPS fix its summary's
+position comes from), connecting to the hub and listening on a
 loopback port of their own (peers find each other through the hub: gossip; multicast scouting is
 off, so nothing leaves loopback). The processes are module-scoped: starting a rover_web costs
 seconds, and the tests release what they engage.
@@ -17,7 +18,7 @@ from dataclasses import dataclass, field
 import pytest
 import requests
 
-from tests.conftest import ServerProcess, free_port
+from tests.conftest import ServerProcess, SimProcess, free_port
 from tests.support.auth import add_users
 
 FLEET = "testfleet"
@@ -35,6 +36,7 @@ class HubRig:
     key_file: str
     tokens: dict
     robots: dict[str, ServerProcess] = field(default_factory=dict)
+    sims: list[SimProcess] = field(default_factory=list)
 
     def headers(self, role: str = "viewer") -> dict:
         return {"Authorization": f"Bearer {self.tokens[role]}"}
@@ -55,6 +57,8 @@ class HubRig:
         port = free_port()
         env = self.robot_env(name, offset, f"http://127.0.0.1:{port}")
         env["ROVER_WEB_DB_PATH"] = str(db_dir / f"{name}.sqlite3")
+        if not any(s.proc.args[-1] == name for s in self.sims):  # a restarted robot keeps its simulator
+            self.sims.append(SimProcess(["--only", "rover", "--robots", name], ROS_DOMAIN_ID=env["ROS_DOMAIN_ID"]))
         robot = ServerProcess(port, env)
         self.robots[name] = robot
         return robot.start()
@@ -89,4 +93,6 @@ def hub_rig(tmp_path_factory):
     finally:
         for robot in rig.robots.values():
             robot.stop()
+        for sim in rig.sims:
+            sim.stop()
         assert hub.stop() == 0, "the hub did not end on SIGTERM"  # Zenoh's threads must not hold it

@@ -66,6 +66,19 @@ def test_the_hub_hears_every_robot_with_its_link(hub_rig):
     assert requests.get(heard["alpha"]["url"] + "api/robots", timeout=5).json()["current"] == "alpha"
 
 
+def test_each_robot_s_position_from_its_simulator_reaches_the_hub(hub_rig):
+    # The fix each robot's simulator publishes in its own ROS domain, as the robot itself shows it.
+    def positions():
+        heard = hub_rig.heard()
+        return heard if all(heard.get(n, {}).get("position") for n in ("alpha", "bravo")) else None
+
+    heard = wait_until(positions, timeout=20, what="both robots' positions on the hub")
+    for name in ("alpha", "bravo"):
+        own = requests.get(hub_rig.robots[name].url + "/api/robots", timeout=5).json()["robots"][0]["position"]
+        assert abs(heard[name]["position"]["lat"] - own["lat"]) < 1e-4
+        assert abs(heard[name]["position"]["lng"] - own["lng"]) < 1e-4
+
+
 def test_the_hub_process_has_no_ros(hub_rig):
     # rclpy's extension module is mapped into a process that imported it (the robots' is the control).
     assert "rclpy" not in loaded_modules(hub_rig.hub.proc.pid)
