@@ -1,6 +1,6 @@
 """The fleet hub (issue 31): one hub hearing N robots over Zenoh, and a stop-all to all of them.
 
-    .venv/bin/python bench/hub.py [--robots 100] [--processes 2] [--seconds 20] [--stops 3]
+    .venv/bin/python bench/hub.py [--robots 100] [--processes 2] [--seconds 20] [--stops 3] [--router]
 
 The hub is `ROVER_WEB_HUB=true flask run` in its own process (Zenoh listening on a free
 127.0.0.1 port; multicast scouting off). The robots are light: `--processes` child processes of
@@ -8,6 +8,10 @@ this script, each one Zenoh client session holding its share of the robots, each
 liveliness token, a stop queryable that checks the signed command (rover_web.zenoh_link.signing)
 and answers signed, and a signed summary of the real shape published at 1 Hz (phases spread).
 No ROS and no rover_web in them: the hub's cost is what is measured.
+
+--router puts a Zenoh router between them, as a site with one router per network would: a
+session in `router` mode in a process of its own (eclipse-zenoh's Python package runs one; no
+zenohd needed), the hub and every robot process its clients.
 
 Reported: the hub's CPU (% of one core) over the measured window, with every robot heard;
 the summaries' age on the hub (`summary_age_s` of GET /api/robots, sampled every 0.5 s for every
@@ -93,16 +97,35 @@ def child(endpoint: str, key_file: str, names: list[str]) -> None:
     session.close()
 
 
+def router(endpoint: str) -> None:
+    """A Zenoh router on `endpoint`, until stdin closes."""
+    import zenoh
+
+    config = zenoh.Config()
+    config.insert_json5("mode", '"router"')
+    config.insert_json5("scouting/multicast/enabled", "false")
+    config.insert_json5("listen/endpoints", json.dumps([endpoint]))
+    session = zenoh.open(config)
+    print("router ready", flush=True)
+    sys.stdin.read()
+    session.close()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--robots", type=int, default=100)
     parser.add_argument("--processes", type=int, default=2)
     parser.add_argument("--seconds", type=float, default=20.0)
     parser.add_argument("--stops", type=int, default=3)
+    parser.add_argument("--router", action="store_true", help="through a Zenoh router process (clients of it)")
+    parser.add_argument("--router-child", metavar="ENDPOINT", help=argparse.SUPPRESS)
     parser.add_argument("--child", nargs=3, metavar=("ENDPOINT", "KEY_FILE", "NAMES"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
         child(args.child[0], args.child[1], args.child[2].split(","))
+        return
+    if args.router_child:
+        router(args.router_child)
         return
 
     tmp = tempfile.TemporaryDirectory(prefix="rover_web-bench-hub-")
@@ -110,8 +133,24 @@ def main() -> None:
     with open(key_file, "w") as fh:
         fh.write(os.urandom(32).hex())
     endpoint = f"tcp/127.0.0.1:{free_port()}"
-    hub = Server(ros_env(ROVER_WEB_HUB="true", ROVER_WEB_ZENOH_MODE="peer", ROVER_WEB_ZENOH_LISTEN=endpoint,
-                         ROVER_WEB_FLEET_NAME=FLEET, ROVER_WEB_FLEET_KEY_FILE=key_file))
+    zrouter = None
+    if args.router:  # the router listens; the hub connects to it as a client, as the robots do
+        zrouter = subprocess.Popen([sys.executable, __file__, "--router-child", endpoint], cwd=ROOT, env=ros_env(),
+                                   stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        if "router ready" not in zrouter.stdout.readline():
+            stop_process(zrouter)
+            raise RuntimeError("the Zenoh router did not start")
+        link = {"ROVER_WEB_ZENOH_MODE": "client", "ROVER_WEB_ZENOH_CONNECT": endpoint}
+    else:
+        link = {"ROVER_WEB_ZENOH_MODE": "peer", "ROVER_WEB_ZENOH_LISTEN": endpoint}
+    try:
+        hub = Server(ros_env(ROVER_WEB_HUB="true", ROVER_WEB_FLEET_NAME=FLEET, ROVER_WEB_FLEET_KEY_FILE=key_file,
+                             **link))
+    except BaseException:
+        if zrouter is not None:
+            zrouter.stdin.close()
+            stop_process(zrouter)
+        raise
     names = [f"r{i:03d}" for i in range(args.robots)]
     shares = [names[i::args.processes] for i in range(args.processes)]
     children = [subprocess.Popen([sys.executable, __file__, "--child", endpoint, key_file, ",".join(share)],
@@ -129,7 +168,8 @@ def main() -> None:
             if time.monotonic() > deadline:
                 raise RuntimeError(f"only {sum(r['heard'] == 'live' for r in robots)} robots live after 30 s")
             time.sleep(0.5)
-        print(f"{machine()}; {args.robots} robots in {len(children)} processes, 1 Hz each, {args.seconds:g} s")
+        print(f"{machine()}; {args.robots} robots in {len(children)} processes, 1 Hz each, {args.seconds:g} s"
+              + ("; through a Zenoh router process" if args.router else "; robots connect to the hub (peer)"))
 
         ages: list[float] = []
         lost = 0
@@ -161,6 +201,12 @@ def main() -> None:
             except (OSError, subprocess.TimeoutExpired):
                 stop_process(proc)
         hub.stop()
+        if zrouter is not None:
+            zrouter.stdin.close()
+            try:
+                zrouter.wait(10)
+            except subprocess.TimeoutExpired:
+                stop_process(zrouter)
         tmp.cleanup()
 
 
