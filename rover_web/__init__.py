@@ -70,6 +70,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         logs,
         panels,
         plot,
+        recording,
         ros_admin,
         scan_the_code,
         telemetry,
@@ -115,6 +116,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         diagnostics.init_app(app, fleet)
         plot.init_app(app, graph)  # after topics: plots share its subscriptions
         ros_admin.init_app(app, graph)
+        recording.init_app(app, fleet)  # last of the features: it records what they publish and do
         fleet_pages.init_app(app, fleet)  # /robots, /api/robots and /robots/<name>/... for every route
     except BaseException:
         # A feature that failed to start may follow others that already started loops and
