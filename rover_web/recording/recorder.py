@@ -70,7 +70,7 @@ class Recorder:
             for topic, t in channels.items()}
         self._topics = {cid: topic for topic, cid in self.channel_ids.items()}
         self._writer.add_metadata("rover_web", metadata)
-        self._writer.flush()  # the header, schemas and channels are on disk before any message
+        self._writer.flush()  # the header on disk now; schemas and channels go in each chunk that uses them
         self._thread = threading.Thread(target=self._run, name=f"recorder-{path.stem}", daemon=True)
         self._thread.start()
 
