@@ -8,21 +8,32 @@ HTTP (routes.py):
   GET    /api/recordings/<id>/file        download, with HTTP Range
   DELETE /api/recordings/<id>             delete (admin)
 Modules: schema (ros2msg schema text), recorder (the writer thread and the MCAP file), service
-(choosing topics, raw subscriptions, the audit trail, limits), store (the SQLite index).
+(choosing topics, raw subscriptions, the audit trail, limits), store (the SQLite index), reading
+(a file whole or cut short), replay (`flask --app rover_web replay FILE`).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rover_web.config import ConfigError
-from rover_web.core.fleet import Fleet
 
-from . import routes
-from .service import AUDIT_TOPIC, RecordingService, parse_presets
-from .store import RecordingIndex
+from .replay import init_cli
 
-__all__ = ["init_app", "RecordingService", "AUDIT_TOPIC", "recordings_folder"]
+if TYPE_CHECKING:
+    from rover_web.core.fleet import Fleet
+
+__all__ = ["init_app", "init_cli", "RecordingService", "AUDIT_TOPIC", "recordings_folder"]
+
+
+def __getattr__(name: str):
+    # The service needs rclpy; `flask replay` and the other CLI commands import this package
+    # before (and without) ROS, so the service is imported only when asked for.
+    if name in ("RecordingService", "AUDIT_TOPIC"):
+        from . import service
+        return getattr(service, name)
+    raise AttributeError(name)
 
 
 def recordings_folder(app) -> Path:
@@ -31,6 +42,10 @@ def recordings_folder(app) -> Path:
 
 
 def init_app(app, fleet: Fleet) -> None:
+    from . import routes
+    from .service import RecordingService, parse_presets
+    from .store import RecordingIndex
+
     try:
         parse_presets(app.config["ROVER_WEB_RECORDING_PRESETS"])
     except ValueError as exc:
