@@ -60,4 +60,5 @@ def init_app(app, fleet: Fleet) -> None:
         service = RecordingService(rover, folder, RecordingIndex(rover.db), extra_audit=(fleet.graph.audit,))
         rover.add_feature(service)
         rover.on_shutdown(service.shutdown)
+        rover.add_nav("Recordings", "/recordings")
     app.register_blueprint(routes.bp)

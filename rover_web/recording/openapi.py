@@ -1,6 +1,6 @@
 """The recordings' routes, for GET /api/openapi.json (see rover_web/apidocs/describe.py)."""
 
-from rover_web.apidocs.describe import BODY_ERRORS, obj, op
+from rover_web.apidocs.describe import BODY_ERRORS, obj, op, page
 
 TOPICS = {"oneOf": [{"const": "all"}, {"type": "string", "pattern": "^preset:.+"},
                     {"type": "array", "items": {"type": "string"}, "minItems": 1, "maxItems": 500}]}
@@ -24,6 +24,7 @@ RECORDING = obj({
 NOT_FOUND = {404: "not_found"}
 
 PATHS = {
+    "/recordings": {"get": page("Recordings: start, stop, status, the list with downloads", tag="recording")},
     "/api/recordings": {
         "get": op("Every recording of the robot: start, duration, size, topics, message counts", tag="recording",
                   ok=obj({"recordings": {"type": "array", "items": RECORDING},

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import re
 
-from flask import Blueprint, jsonify, request, send_file
+from flask import Blueprint, jsonify, render_template, request, send_file
 
 from rover_web.auth import signed_in_name
 from rover_web.core.state import current_feature
@@ -61,6 +61,13 @@ def parse_selection(body: dict) -> Selection:
     if not isinstance(name, str) or len(name) > MAX_NAME or any(ord(c) < 32 for c in name):
         raise ApiError(400, "bad_name", f"'name' is text of at most {MAX_NAME} characters, on one line")
     return Selection(topics, camera, name.strip())
+
+
+@bp.get("/recordings")
+def recordings_page():
+    """Start and stop (operators), the list with downloads (viewers); static/js/recording/."""
+    service = _service()
+    return render_template("recordings.html", presets=sorted(service.presets))
 
 
 @bp.get("/api/recordings")
