@@ -46,6 +46,17 @@ PATHS = {
                      ok=obj({"deleted": {"type": "string"}}),
                      errors={**NOT_FOUND, 409: "recording_in_progress"}),
     },
+    "/recordings/{recording_id}/replay": {
+        "get": page("Replay a recording in the browser: track, logs and audit trail on a time slider",
+                    tag="recording", errors=NOT_FOUND)},
+    "/api/recordings/{recording_id}/timeline": {
+        "get": op("A recording as a timeline: GPS and odometry tracks, /rosout lines, the audit trail", tag="recording",
+                  ok=obj({"id": {"type": "string"}, "start": {"type": ["number", "null"]},
+                          "end": {"type": ["number", "null"]}, "complete": {"type": "boolean"},
+                          "series": {"type": "object"}, "logs": {"type": "array"}, "audit": {"type": "array"}},
+                         ("start", "end", "series", "logs", "audit")),
+                  errors={**NOT_FOUND, 409: "recording_in_progress", 422: "not_a_recording"}),
+    },
     "/api/recordings/{recording_id}/stop": {
         "post": op("Stop the recording: its file gets its summary and footer", tag="recording", role="operator",
                    ok=RECORDING, errors=NOT_FOUND),

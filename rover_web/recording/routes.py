@@ -108,6 +108,28 @@ def recording_file(recording_id: str):
                      download_name=f"{recording_id}.mcap", conditional=True, max_age=0)
 
 
+@bp.get("/recordings/<recording_id>/replay")
+def replay_page(recording_id: str):
+    """The replay view: a time slider over the track, the logs and the audit trail; publishes nothing."""
+    status = _service().status(_id(recording_id))
+    return render_template("recording_replay.html", recording=status)
+
+
+@bp.get("/api/recordings/<recording_id>/timeline")
+def recording_timeline(recording_id: str):
+    from .reading import NotARecording
+    from .timeline import timeline
+
+    service = _service()
+    status = service.status(_id(recording_id))
+    if status["state"] == "recording":
+        raise ApiError(409, "recording_in_progress", "the file is still being written: stop the recording first")
+    try:
+        return jsonify(id=recording_id, **timeline(service.path_of(recording_id)))
+    except NotARecording as exc:
+        raise ApiError(422, "not_a_recording", str(exc)) from None
+
+
 @bp.delete("/api/recordings/<recording_id>")
 def delete_recording(recording_id: str):
     _service().delete(_id(recording_id), _by())

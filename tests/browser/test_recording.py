@@ -64,3 +64,24 @@ def test_a_viewer_sees_the_list_with_downloads_but_cannot_start(signed_server, b
         expect(page.locator("#rec-start")).to_be_disabled()
     finally:
         context.close()
+
+
+def test_the_replay_view_moves_through_the_recording_and_sends_nothing(live_server, ros_peer, page):
+    from tests.integration.recording.test_timeline import record_a_short_run
+
+    recording_id = record_a_short_run(live_server, ros_peer("replay_view_peer"))
+    sent = []
+    page.on("request", lambda r: r.method != "GET" and sent.append(f"{r.method} {r.url}"))
+    page.goto(f"{live_server.url}/recordings/{recording_id}/replay", wait_until="load")
+    expect(page.locator("#replay-track-name")).to_have_text("/tl/fix (GPS)", timeout=WAIT_MS)
+    page.locator("#replay-slider").fill("0")
+    expect(page.locator("#replay-audit")).not_to_contain_text("carol")
+    page.locator("#replay-slider").fill("1000")  # the end: everything has happened
+    expect(page.locator("#replay-audit")).to_contain_text("carol: e-stop engaged by carol")
+    expect(page.locator("#replay-logs")).to_contain_text("[WARN] replay_view_peer: thruster two hot")
+    expect(page.locator("#replay-position")).to_have_text("at 27.370400, -82.450400")
+    page.locator("#replay-slider").fill("0")
+    page.click("#replay-play")
+    expect(page.locator("#replay-play")).to_have_text("Play", timeout=WAIT_MS)  # played to the end at 1x
+    expect(page.locator("#replay-audit")).to_contain_text("carol")
+    assert sent == [] and page.watch.console_errors == []

@@ -58,7 +58,10 @@ function row(rec) {
     link.href = at(rec.file);
     link.textContent = 'download';
     link.setAttribute('download', '');
-    actions.append(link);
+    const replay = document.createElement('a');
+    replay.href = at(`/recordings/${rec.id}/replay`);
+    replay.textContent = 'replay';
+    actions.append(link, ' ', replay);
     if (canDelete) {
       const remove = document.createElement('button');
       remove.type = 'button';
