@@ -10,7 +10,7 @@ RECORDING = obj({
     "id": {"type": "string"}, "name": {"type": "string"}, "robot": {"type": "string"},
     "state": {"enum": ["recording", "stopped", "interrupted"]},
     "stop_reason": {"enum": [None, "requested", "shutdown", "max_size", "folder_full", "disk_low", "write_error",
-                             "interrupted"]},
+                             "interrupted", "subscribe_failed"]},
     "error": {"type": ["string", "null"]},
     "started_at": {"type": "number"}, "ended_at": {"type": ["number", "null"]}, "duration_s": {"type": "number"},
     "size": {"type": "integer"}, "started_by": {"type": "string"}, "stopped_by": {"type": ["string", "null"]},
@@ -35,6 +35,7 @@ PATHS = {
                                 "unknown_preset",
                            409: "recording_in_progress (one at a time per robot)",
                            422: "unknown_topic (a listed topic has no publisher, or no installed definition)",
+                           503: "subscribe_failed",
                            507: "folder_full, disk_low, cannot_write", **BODY_ERRORS},
                    fuzz="last", fuzz_why="a recording started by the fuzzer runs until stopped: the rest of the "
                                          "POSTs would meet 409"),

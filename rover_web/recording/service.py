@@ -100,7 +100,14 @@ class RecordingService:
                                          "skipped": skipped, "left_out": left_out}),
                 "topics": {**channels, AUDIT_TOPIC: AUDIT_TYPE}})
             self._active = active
-        self._subscribe(active, channels)
+        try:
+            self._subscribe(active, channels)
+        except Exception as exc:  # rclpy refused a subscription: end the file cleanly, say why
+            log.exception("recording %s: could not subscribe", recording_id)
+            self._teardown(active)
+            active.recorder.error = f"{type(exc).__name__}: {exc}"[:300]
+            active.recorder.stop("subscribe_failed")
+            raise ApiError(503, "subscribe_failed", f"could not subscribe to the topics: {exc}") from None
         self.rover.audit.record("recording.start", by=by, detail=f"recording {recording_id} started",
                                 recording=recording_id, topics=len(channels))
         return self.status(recording_id)

@@ -30,7 +30,8 @@ const REASONS = {
   requested: 'stopped', shutdown: 'stopped: the server shut down', max_size: 'stopped: it reached ROVER_WEB_RECORDING_MAX_MB',
   folder_full: 'stopped: the recordings folder is full (ROVER_WEB_RECORDINGS_MAX_MB)',
   disk_low: 'stopped: the disk is nearly full (ROVER_WEB_RECORDINGS_MIN_FREE_MB)',
-  write_error: 'stopped: it could not be written', interrupted: 'interrupted: the server stopped without finishing it',
+  write_error: 'stopped: it could not be written', subscribe_failed: 'stopped: a topic could not be subscribed to',
+  interrupted: 'interrupted: the server stopped without finishing it',
 };
 
 function stateText(rec) {

@@ -171,3 +171,21 @@ def test_roles_viewers_list_operators_record_admins_delete(signed_server_factory
     assert stopped["stopped_by"] == "operator"
     assert requests.delete(url, headers=bearer(server, "operator"), timeout=5).status_code == 403
     assert requests.delete(url, headers=bearer(server, "admin"), timeout=5).status_code == 200
+
+
+def test_a_subscription_rclpy_refuses_ends_the_recording_cleanly_and_says_why(app_factory, monkeypatch):
+    app = app_factory()
+    client = app.test_client()
+    runtime = app.extensions["rover_web"].runtime
+    wait_until(lambda: "/cmd_vel" in dict(runtime.node.get_topic_names_and_types()), 10, "own topics seen")
+
+    def refuse(*args, **kwargs):
+        raise RuntimeError("rmw said no")
+
+    monkeypatch.setattr(runtime, "subscribe", refuse)
+    answer = client.post("/api/recordings", json={"topics": "all"})
+    assert answer.status_code == 503 and answer.json["error"] == "subscribe_failed"
+    (listed,) = client.get("/api/recordings").json["recordings"]
+    assert (listed["state"], listed["stop_reason"], listed["error"]) == ("stopped", "subscribe_failed",
+                                                                         "RuntimeError: rmw said no")
+    assert client.post("/api/recordings", json={"topics": "all"}).status_code == 503  # not stuck at 409
