@@ -1,22 +1,24 @@
 """Recorder: one MCAP file being written, by its own thread, from a bounded queue.
 
 ROS callbacks (on the executor) and audit listeners (on request threads) only `offer` a message:
-a put that never waits. A full queue means the disk or the writer fell behind; the message is
-counted as dropped for its topic instead of stalling the executor, which also serves teleop and the
-e-stop. The writer thread owns the mcap Writer: chunked, zstd, and flushed (chunk closed, bytes
-handed to the OS) every FLUSH_S, so a process killed mid-recording leaves a file readable up to
-its last flushed chunk (docs/recording.md#crash-safety).
+an append to a deque, which never waits and wakes nobody. The writer takes what came every
+BATCH_S: a queue.Queue woke it (a lock and a notify on the executor thread) for every message,
+the executor's largest recording cost in a profile of bench/recording.py. A full queue means the
+disk or the writer fell behind; the message is counted as dropped for its topic instead of
+stalling the executor, which also serves teleop and the e-stop. The writer thread owns the mcap
+Writer: chunked, zstd, and flushed (chunk closed, bytes handed to the OS) every FLUSH_S, so a
+process killed mid-recording leaves a file readable up to its last flushed chunk
+(docs/recording.md#crash-safety).
 """
 
 from __future__ import annotations
 
 import logging
 import os
-import queue
 import shutil
 import threading
 import time
-from collections import Counter
+from collections import Counter, deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,7 +31,7 @@ log = logging.getLogger(__name__)
 
 FLUSH_S = 1.0  # at most this much recorded time is lost when the process dies
 CHUNK_BYTES = 1024 * 1024  # uncompressed; a full chunk is written before FLUSH_S comes round
-_STOP = object()
+BATCH_S = 0.05  # the writer wakes this often, and at once to stop
 
 
 @dataclass(frozen=True)
@@ -49,7 +51,9 @@ class Recorder:
         schemas = {type_name: schema_text(type_name) for type_name in set(channels.values())}
         self.path = path
         self.limits = limits
-        self._queue: queue.Queue = queue.Queue(maxsize=queue_size)
+        self._pending: deque = deque()  # append and popleft are atomic: no lock on the executor's path
+        self._queue_size = queue_size
+        self._wake = threading.Event()
         self._on_progress = on_progress
         self._on_end = on_end
         self.counts: Counter = Counter()  # written, per topic
@@ -80,18 +84,17 @@ class Recorder:
         """Queue one serialized (CDR) message; never waits. False (and counted) when dropped."""
         if self.stop_reason is not None:
             return False
-        try:
-            self._queue.put_nowait((self.channel_ids[topic], log_time_ns or time.time_ns(), data))
-        except queue.Full:
+        if len(self._pending) >= self._queue_size:  # two offers at once may pass by one: still bounded
             self.dropped[topic] += 1
             return False
+        self._pending.append((self.channel_ids[topic], log_time_ns or time.time_ns(), data))
         return True
 
     def stop(self, reason: str, timeout_s: float = 10.0) -> None:
         """Finish the file (summary and footer) and wait for the writer thread, at most timeout_s."""
         if self.stop_reason is None:
             self.stop_reason = reason
-        self._wake()
+        self._wake.set()
         self._thread.join(timeout_s)
 
     @property
@@ -99,29 +102,18 @@ class Recorder:
         return self._thread.is_alive()
 
     def queued(self) -> int:
-        return self._queue.qsize()
+        return len(self._pending)
 
     # --- the writer thread ---
-
-    def _wake(self) -> None:
-        try:
-            self._queue.put_nowait(_STOP)
-        except queue.Full:
-            pass  # the thread is busy with a full queue and sees stop_reason after its next batch
 
     def _run(self) -> None:
         next_flush = time.monotonic() + FLUSH_S
         try:
             while True:
-                timeout = max(0.0, next_flush - time.monotonic())
-                try:
-                    item = self._queue.get(timeout=timeout)
-                except queue.Empty:
-                    item = None
-                if item is not None and item is not _STOP:
-                    self._write(item)
+                self._wake.wait(BATCH_S)
+                self._drain()
                 if self.stop_reason is not None:
-                    self._drain()
+                    self._drain()  # what an offer appended while the reason was being set
                     break
                 if time.monotonic() >= next_flush:
                     next_flush = time.monotonic() + FLUSH_S
@@ -148,13 +140,9 @@ class Recorder:
         self.counts[self._topics[channel_id]] += 1
 
     def _drain(self) -> None:
-        while True:
-            try:
-                item = self._queue.get_nowait()
-            except queue.Empty:
-                return
-            if item is not _STOP:
-                self._write(item)
+        pending = self._pending
+        while pending:
+            self._write(pending.popleft())
 
     def _limit_reached(self) -> str | None:
         limits = self.limits
