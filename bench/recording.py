@@ -6,7 +6,8 @@ gradient with noise, so zstd gets a camera-like ratio, not a blank frame's), /im
 50 Hz), /fix (5 Hz), /battery_state (1 Hz) and 15 /bench/sensor_N (std_msgs/Float64MultiArray of
 16 values, 10 Hz). Phases: the same traffic not recorded (baseline), then recorded with the camera
 (ROVER_WEB_RECORDING_CAMERA_MAX_HZ=10). Prints the recorder's CPU (recording minus baseline, % of
-one core), MB per minute, and messages written and dropped against those published.
+one core), MB per minute, messages written and dropped against those published, and the latency
+of the `odom` event (the /odom stamp to an SSE client's socket) in both phases.
 
     .venv/bin/python bench/recording.py [--seconds 20] [--baseline 10]
 """
@@ -21,7 +22,7 @@ import time
 from pathlib import Path
 
 import requests
-from common import ROOT, Server, machine, ros_env, stop_process, wait_for_topic
+from common import ROOT, Server, SseFleet, machine, ros_env, stop_process, summary_ms, wait_for_topic
 
 SENSORS = 15
 RATES = {"/odom": 50.0, "/camera/image_raw": 10.0, "/imu": 50.0, "/fix": 5.0, "/battery_state": 1.0,
@@ -52,7 +53,13 @@ def publish() -> None:
         frame ^= rng.integers(0, 8, frame.shape, dtype=np.uint8)  # sensor noise in the low bits
         return Image(height=480, width=640, encoding="rgb8", step=640 * 3, data=frame.tobytes())
 
-    makers = {"/odom": (Odometry, lambda i: Odometry(child_frame_id="base_link")),
+    def odom(i: int) -> Odometry:
+        msg = Odometry(child_frame_id="base_link")
+        ns = time.monotonic_ns()  # CLOCK_MONOTONIC, for the odom event's latency to the SSE client
+        msg.header.stamp.sec, msg.header.stamp.nanosec = ns // 1_000_000_000, ns % 1_000_000_000
+        return msg
+
+    makers = {"/odom": (Odometry, odom),
               "/camera/image_raw": (Image, image), "/imu": (Imu, lambda i: Imu()),
               "/fix": (NavSatFix, lambda i: NavSatFix(latitude=27.37, longitude=-82.45)),
               "/battery_state": (BatteryState, lambda i: BatteryState(voltage=12.0)),
@@ -99,16 +106,24 @@ def main() -> None:
             raise RuntimeError("the publisher did not start")
         for topic in RATES:
             wait_for_topic(server, topic, f"{topic} discovered")
-        time.sleep(1.0)
-        cpu0, t0 = server.cpu_seconds(), time.monotonic()
-        time.sleep(args.baseline)
-        baseline = 100 * (server.cpu_seconds() - cpu0) / (time.monotonic() - t0)
+        fleet = SseFleet(server.url, "/api/events?channels=odom", 1)
+        fleet.poll(1.0, lambda *a: None)  # the snapshot
+        latency: dict[str, list[float]] = {"not recording": [], "recording": []}
+
+        def measure(phase: str, seconds: float) -> float:
+            def on_event(_woken, arrived, name, data):
+                if name == "odom" and data.get("stamp"):
+                    latency[phase].append(arrived - data["stamp"])
+            cpu0, t0 = server.cpu_seconds(), time.monotonic()
+            fleet.poll(seconds, on_event)
+            return 100 * (server.cpu_seconds() - cpu0) / (time.monotonic() - t0)
+
+        baseline = measure("not recording", args.baseline)
 
         body = {"topics": list(RATES), "camera": not args.no_camera}
         started = requests.post(server.url + "/api/recordings", json=body, timeout=10).json()
-        cpu0, t0 = server.cpu_seconds(), time.monotonic()
-        time.sleep(args.seconds)
-        recording = 100 * (server.cpu_seconds() - cpu0) / (time.monotonic() - t0)
+        recording = measure("recording", args.seconds)
+        fleet.close()
         done = requests.post(f"{server.url}/api/recordings/{started['id']}/stop", json={}, timeout=30).json()
     finally:
         publisher.stdin.close()
@@ -126,6 +141,8 @@ def main() -> None:
     print(f"server CPU: {baseline:.1f} % of a core not recording, {recording:.1f} % recording: "
           f"the recorder {recording - baseline:.1f} %")
     print(f"file: {size_mb:.1f} MB, {size_mb / minutes:.1f} MB per minute")
+    for phase, values in latency.items():
+        print(f"odom event latency, {phase}: {summary_ms(values)}")
 
 
 if __name__ == "__main__":
