@@ -111,8 +111,12 @@ def recording_file(recording_id: str):
 @bp.get("/recordings/<recording_id>/replay")
 def replay_page(recording_id: str):
     """The replay view: a time slider over the track, the logs and the audit trail; publishes nothing."""
+    from rover_web.waypoints.service import WaypointsService
+
     status = _service().status(_id(recording_id))
-    return render_template("recording_replay.html", recording=status)
+    # The waypoints map's own settings and offline basemap: the track shows where the robot was.
+    return render_template("recording_replay.html", recording=status,
+                           map_config=current_feature(WaypointsService).map_config())
 
 
 @bp.get("/api/recordings/<recording_id>/timeline")

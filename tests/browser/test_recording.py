@@ -80,6 +80,13 @@ def test_the_replay_view_moves_through_the_recording_and_sends_nothing(live_serv
     expect(page.locator("#replay-audit")).to_contain_text("carol: e-stop engaged by carol")
     expect(page.locator("#replay-logs")).to_contain_text("[WARN] replay_view_peer: thruster two hot")
     expect(page.locator("#replay-position")).to_have_text("at 27.370400, -82.450400")
+    # On the waypoints map (MapLibre, the app's own style): the red point is the last fix.
+    page.wait_for_selector("#replay-map[data-ready='yes']", timeout=WAIT_MS)
+    page.locator("#replay-slider").fill("999")
+    page.locator("#replay-slider").fill("1000")
+    here = page.evaluate("window.roverReplayMap.getSource('replay-here').serialize().data.features[0]"
+                         ".geometry.coordinates")
+    assert [round(c, 6) for c in here] == [-82.4504, 27.3704]
     page.locator("#replay-slider").fill("0")
     page.click("#replay-play")
     expect(page.locator("#replay-play")).to_have_text("Play", timeout=WAIT_MS)  # played to the end at 1x

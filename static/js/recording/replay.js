@@ -1,7 +1,9 @@
-// The replay view: a recording's GPS (or odometry) track, its /rosout lines and its audit trail,
-// on a time slider with play/pause and speed. Everything comes from one GET of the recording's
-// timeline (decoded on the server); this page sends nothing to the robot and publishes nothing.
+// The replay view: a recording's GPS track on the waypoints map (or, without GPS, its odometry
+// track on a canvas), its /rosout lines and its audit trail, on a time slider with play/pause and
+// speed. Everything comes from one GET of the recording's timeline (decoded on the server); this
+// page sends nothing to the robot and publishes nothing.
 import { api } from '../api.js';
+import { createGpsMap } from '../gps_map.js';
 
 const $ = (id) => document.getElementById(id);
 const id = $('replay').dataset.id;
@@ -14,16 +16,20 @@ const SHOWN_LINES = 50;
 
 let data = null;
 let track = [];  // [{t, a, b}]: a, b are lng, lat (GPS) or x, y (odometry)
+let gps = false;
+let map = null;  // the MapLibre map, once loaded (GPS tracks only)
 let now = 0;  // seconds since the recording's start
 let playing = false;
 let lastFrame = 0;
 
 function chooseTrack(series) {
   const fix = Object.entries(series.fix || {})[0];
-  if (fix) return { name: `${fix[0]} (GPS)`, points: fix[1].map((p) => ({ t: p.t, a: p.lng, b: p.lat })) };
+  if (fix) return { name: `${fix[0]} (GPS)`, gps: true, points: fix[1].map((p) => ({ t: p.t, a: p.lng, b: p.lat })) };
   const odom = Object.entries(series.odom || {})[0];
-  if (odom) return { name: `${odom[0]} (odometry)`, points: odom[1].map((p) => ({ t: p.t, a: p.x, b: p.y })) };
-  return { name: 'no GPS or odometry in this recording', points: [] };
+  if (odom) {
+    return { name: `${odom[0]} (odometry)`, gps: false, points: odom[1].map((p) => ({ t: p.t, a: p.x, b: p.y })) };
+  }
+  return { name: 'no GPS or odometry in this recording', gps: false, points: [] };
 }
 
 function bounds(points) {
@@ -39,7 +45,55 @@ function toCanvas(box, p) {
   return [(p.a - box.a0) * scale, canvas.height - (p.b - box.b0) * scale];
 }
 
+const line = (points) => ({ type: 'Feature', properties: {},
+  geometry: { type: 'LineString', coordinates: points.map((p) => [p.a, p.b]) } });
+const point = (p) => ({ type: 'FeatureCollection', features: p
+  ? [{ type: 'Feature', properties: {}, geometry: { type: 'Point', coordinates: [p.a, p.b] } }] : [] });
+
+function drawOnMap(t) {
+  const past = track.filter((p) => p.t <= t);
+  const here = past.length ? past[past.length - 1] : null;
+  if (map) {
+    map.getSource('replay-past').setData(line(past.length > 1 ? past : []));
+    map.getSource('replay-here').setData(point(here));
+  }
+  return here;
+}
+
+function startMap() {
+  const container = $('replay-map');
+  container.hidden = false;
+  const sources = {
+    'replay-track': { type: 'geojson', data: line(track) },
+    'replay-past': { type: 'geojson', data: line([]) },
+    'replay-here': { type: 'geojson', data: point(null) },
+  };
+  const layers = [
+    { id: 'replay-track', type: 'line', source: 'replay-track', paint: { 'line-color': '#9e9e9e', 'line-width': 2 } },
+    { id: 'replay-past', type: 'line', source: 'replay-past', paint: { 'line-color': '#42a5f5', 'line-width': 3 } },
+    { id: 'replay-here', type: 'circle', source: 'replay-here',
+      paint: { 'circle-radius': 6, 'circle-color': '#e53935', 'circle-stroke-color': '#fff', 'circle-stroke-width': 2 } },
+  ];
+  try {
+    const created = createGpsMap(container, JSON.parse(container.dataset.config), { sources, layers,
+      onLoad: (loaded) => {
+        map = loaded;
+        const lngs = track.map((p) => p.a);
+        const lats = track.map((p) => p.b);
+        map.fitBounds([[Math.min(...lngs), Math.min(...lats)], [Math.max(...lngs), Math.max(...lats)]],
+          { padding: 40, maxZoom: 19, duration: 0 });
+        show();
+      } });
+    window.roverReplayMap = created;  // for the browser tests and the curious operator's console
+  } catch (err) {  // no WebGL: the canvas still shows the track
+    container.hidden = true;
+    gps = false;
+  }
+}
+
 function drawTrack(t) {
+  if (gps) return drawOnMap(t);
+  canvas.hidden = false;
   ctx.clearRect(0, 0, canvas.width, canvas.height);
   if (!track.length) return null;
   const box = bounds(track);
@@ -131,7 +185,9 @@ async function load() {
   }
   const chosen = chooseTrack(data.series);
   track = chosen.points;
+  gps = chosen.gps;
   $('replay-track-name').textContent = chosen.name;
+  if (gps) startMap();
   show();
 }
 
