@@ -1,6 +1,8 @@
 """The recordings page in Chromium: an operator records a list of topics from a peer in another
 process, sees it run, stops it, and downloads the MCAP file; a viewer sees the list and no start."""
 
+import re
+
 import pytest
 import requests
 from playwright.sync_api import expect
@@ -33,7 +35,8 @@ def test_an_operator_records_topics_sees_it_run_stops_it_and_downloads_it(live_s
     row = page.locator("#rec-rows tr[data-state='stopped']")
     expect(row).to_have_count(1, timeout=WAIT_MS)
     expect(row.locator("td").nth(5)).to_have_text("7")  # and the trail's "recording.stop"
-    href = row.locator("a").get_attribute("href")
+    href = row.locator("a[download]").get_attribute("href")
+    expect(row.locator("a", has_text="replay")).to_have_attribute("href", re.compile(r"/replay$"))
     assert requests.get(live_server.url + href, timeout=10).content.startswith(b"\x89MCAP0\r\n")
     assert page.watch.console_errors == [] and page.watch.offhost == []
     # A refused start is said on the page: a topic nobody publishes (Chromium logs the 422 itself).
@@ -59,7 +62,7 @@ def test_a_viewer_sees_the_list_with_downloads_but_cannot_start(signed_server, b
         page.wait_for_url("**/recordings", wait_until="load")
         row = page.locator("#rec-rows tr[data-state='stopped']")
         expect(row).to_contain_text("seen by viewers", timeout=WAIT_MS)
-        expect(row.locator("a")).to_have_text("download")
+        expect(row.locator("a[download]")).to_have_text("download")
         expect(row.locator("button")).to_have_count(0)  # deleting is an admin's
         expect(page.locator("#rec-start")).to_be_disabled()
     finally:
