@@ -45,7 +45,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     # The web layer first (every route's protection), then the CLI commands: those are registered
     # before, and without, the ROS node, so `flask tiles fetch` or `flask users add` never joins
     # the ROS graph.
-    from rover_web import auth, basemap, linkemu
+    from rover_web import auth, basemap, linkemu, recording
     from rover_web.web import dev_server, http
 
     http.init_app(app)
@@ -53,6 +53,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     auth.init_cli(app)
     basemap.init_cli(app)
     linkemu.init_cli(app)
+    recording.init_cli(app)  # `flask replay` makes its own ROS node, only when it runs
     if process.is_reloader_watcher():
         log.warning("reloader watcher process: the ROS node starts in the serving child only")
         return app
@@ -77,6 +78,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         logs,
         panels,
         plot,
+        recording,
         ros_admin,
         scan_the_code,
         telemetry,
@@ -122,6 +124,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         diagnostics.init_app(app, fleet)
         plot.init_app(app, graph)  # after topics: plots share its subscriptions
         ros_admin.init_app(app, graph)
+        recording.init_app(app, fleet)  # last of the features: it records what they publish and do
         fleet_pages.init_app(app, fleet)  # /robots, /api/robots and /robots/<name>/... for every route
         zenoh_link.init_app(fleet)  # last: its summaries read every feature; its stop engages the e-stop
     except BaseException:

@@ -333,6 +333,26 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("CODE_CONFIRM_CYCLES", 1, "int",
             "complete cycles in a row that must agree before a code is confirmed and published", 1, 20),
     Setting("CODE_HISTORY_LENGTH", 10, "int", "completed cycles (codes and invalid ones) kept in the history", 1, 100),
+    # --- recordings (docs/recording.md) ---
+    Setting("RECORDINGS_DIR", None, "optional_str",
+            "folder MCAP recordings are written to; unset: recordings/ in the Flask instance folder"),
+    Setting("RECORDING_MAX_MB", 2048.0, "float",
+            "a recording stops (max_size) once its file reaches this size (MB, one chunk may pass it)", 0.01, 1e7),
+    Setting("RECORDINGS_MAX_MB", 20480.0, "float",
+            "all recordings together may take this much (MB): a recording stops (folder_full) there, and none "
+            "starts beyond it", 0.01, 1e8),
+    Setting("RECORDINGS_MIN_FREE_MB", 1024.0, "float",
+            "a recording stops (disk_low), and none starts, while the disk holding them has less free (MB)",
+            0, 1e8),
+    Setting("RECORDING_PRESETS", ["navigation=/odom /fix /amcl_pose /plan /goal_pose /cmd_vel /e_stop /rosout "
+                                  "/diagnostics"], "list",
+            "topic sets a recording can name as preset:NAME, each NAME=/topic /topic ... (under each robot's "
+            "namespace)"),
+    Setting("RECORDING_CAMERA_MAX_HZ", 2.0, "float",
+            "most frames a second a recording keeps of each image topic when it records the camera", 0.1, 60),
+    Setting("RECORDING_QUEUE", 10000, "int",
+            "messages waiting for the recording's writer thread; beyond, new ones are counted as dropped", 100,
+            1000000),
 )
 
 _BY_NAME = {PREFIX + s.name: s for s in SETTINGS}

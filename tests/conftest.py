@@ -69,7 +69,8 @@ def app_factory(tmp_path):
         config = {"TESTING": True, "ROVER_WEB_DB_PATH": str(tmp_path / f"rover_web{len(made)}.sqlite3"),
                   # 32+ bytes (a shorter key is refused), and no key file in the checkout's instance folder
                   "ROVER_WEB_SECRET_KEY": "tests-" + "k" * 32,
-                  "ROVER_WEB_HOST": "127.0.0.1"}  # where the in-process test servers listen
+                  "ROVER_WEB_HOST": "127.0.0.1",  # where the in-process test servers listen
+                  "ROVER_WEB_RECORDINGS_DIR": str(tmp_path / f"recordings{len(made)}")}  # not the checkout's
         config.update(settings)
         app = create_app(config)
         made.append(app)
@@ -232,6 +233,7 @@ def server_process(tmp_path):
     def make(port=None, env=None, args=None, scheme="http", ca=None):
         env = dict(env or {})
         env.setdefault("ROVER_WEB_DB_PATH", str(tmp_path / f"server{len(started)}.sqlite3"))
+        env.setdefault("ROVER_WEB_RECORDINGS_DIR", str(tmp_path / f"server{len(started)}-recordings"))
         server = ServerProcess(port, env, args, scheme, ca)
         started.append(server)
         return server

@@ -34,7 +34,9 @@ ANY_USER_ENDPOINTS = frozenset({"auth.logout", "auth.revoke_my_sessions", "estop
                                 "hub.estop_all",
                                 "camera_webrtc.whep_offer", "camera_webrtc.whep_end", "camera.viewer_ack"})
 ADMIN_ENDPOINT_PREFIX = "auth.admin_"
-ADMIN_ENDPOINTS = frozenset({"ros_admin.api_set_parameter", "ros_admin.api_call_service", "ros_admin.api_send_goal"})
+# recording.delete_recording: a recording is the record of what happened; only an admin destroys it.
+ADMIN_ENDPOINTS = frozenset({"ros_admin.api_set_parameter", "ros_admin.api_call_service", "ros_admin.api_send_goal",
+                             "recording.delete_recording"})
 
 
 def required_role(method: str, path: str, endpoint: str | None) -> str | None:

@@ -25,6 +25,13 @@ def _service() -> AuthService:
     return current_feature(AuthService)
 
 
+def _audit(action: str, by: str, detail: str) -> None:
+    """Sign-ins concern every robot: the graph-wide AuditHub (the only robot's, when there is one)."""
+    rover = current_rover()
+    hub = rover.fleet.graph.audit if rover.fleet is not None else rover.audit
+    hub.record(action, by=by, detail=detail, address=request.remote_addr or "unknown")
+
+
 @bp.before_app_request
 def check_access():
     auth = _service()
@@ -130,9 +137,11 @@ def login():
                               username, next_path, retry_after_s=1)
     if user is None:
         auth.throttle.failed(username, address)
+        _audit("auth.sign_in_refused", username, f"wrong password or user name for {username!r}")
         return _login_refused(as_json, 401, "bad_credentials", "wrong user name or password", username, next_path)
     auth.throttle.succeeded(username, address)
     _start_session(auth, user.name)
+    _audit("auth.sign_in", user.name, f"{user.name} signed in ({user.role})")
     if as_json:
         return jsonify(user=user.name, role=user.role)
     return redirect(next_path, 303)
@@ -164,6 +173,8 @@ def _start_session(auth: AuthService, user_name: str) -> None:
 @accepts_form
 def logout():
     auth = _service()
+    if current_user.is_authenticated:
+        _audit("auth.sign_out", current_user.name, f"{current_user.name} signed out")
     if current_user.is_authenticated and current_user.via == "session":
         auth.sessions.end(current_user.get_id())  # a copy of the cookie is refused from now on
         logout_user()

@@ -18,6 +18,7 @@ from flask import current_app, has_request_context, request
 from rover_web.core.loops import Loop, every
 from rover_web.core.robots import Robot
 from rover_web.core.streams import StreamLimit
+from rover_web.events.audit import AuditHub
 
 if TYPE_CHECKING:
     from rover_web.core.fleet import Fleet
@@ -63,6 +64,7 @@ class Rover:
         self.db = db
         self.broadcaster = broadcaster  # writes every SSE stream
         self.robot = robot or Robot("robot")
+        self.audit = AuditHub(self.robot.name)  # operator actions, for recordings (events/audit.py)
         self.fleet: Fleet | None = None  # set by the Fleet that holds this robot
         # SSE, MJPEG, echo and teleop sockets: one limit for the process, shared by every robot.
         self.streams = streams or StreamLimit(config["ROVER_WEB_MAX_STREAMS"])

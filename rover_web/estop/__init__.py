@@ -57,6 +57,10 @@ def _init_robot(rover: Rover) -> None:
         canceller=canceller,
         on_change=lambda state: rover.hub.publish(CHANNEL, state))
     rover.add_feature(estop)
+    # Who engaged and released it, for recordings (events/audit.py); `via` says from where.
+    estop.on_engage(lambda by: rover.audit.record("estop.engage", by=by, detail=f"e-stop engaged by {by}",
+                                                  via=estop.state().get("via")))
+    estop.on_release(lambda by: rover.audit.record("estop.release", by=by, detail=f"e-stop released by {by}"))
     rover.hub.publish(CHANNEL, estop.state())
     estop.republish()  # a late joiner gets the latch from the transient-local history at once
     rover.every(config["ROVER_WEB_ESTOP_REPEAT_S"], estop.republish, name="estop-republish")

@@ -44,7 +44,8 @@ def _init_robot(rover: Rover) -> None:
     service = GeofenceService(GeofenceStore(rover.db), rover.feature(EStopService), rover.hub,
                               max_vertices=config["ROVER_WEB_GEOFENCE_MAX_VERTICES"],
                               engage_estop=config["ROVER_WEB_GEOFENCE_ESTOP"],
-                              oplog=OperatorLog(rover.db, config["ROVER_WEB_PANELS_LOG_KEEP"]))
+                              oplog=OperatorLog(rover.db, config["ROVER_WEB_PANELS_LOG_KEEP"],
+                                                          audit=rover.audit))
     rover.hub.register(CHANNEL)
     if config["ROVER_WEB_GEOFENCE_FILE"]:
         service.seed(_read_file(config["ROVER_WEB_GEOFENCE_FILE"], service.max_vertices))

@@ -31,7 +31,8 @@ def _init_robot(rover: Rover) -> None:
     specs = tuple(s.resolved(rover.resolve) for s in specs)  # each robot's panels drive its own topics
     rover.hub.register("panel", "panel_log")
     estop = rover.feature(EStopService)
-    service = PanelService(specs, rover, OperatorLog(rover.db, config["ROVER_WEB_PANELS_LOG_KEEP"]), estop)
+    oplog = OperatorLog(rover.db, config["ROVER_WEB_PANELS_LOG_KEEP"], audit=rover.audit)
+    service = PanelService(specs, rover, oplog, estop)
     rover.add_feature(service)
     estop.on_engage(service.on_estop)
     estop.on_release(lambda _by: service.publish_view())  # the page's buttons come back

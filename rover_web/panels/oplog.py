@@ -66,14 +66,18 @@ def entry_dict(row) -> dict:
 
 
 class OperatorLog:
-    def __init__(self, db, keep: int):
+    def __init__(self, db, keep: int, audit=None):
         self._db = db
         self._keep = keep
+        self._audit = audit  # the robot's AuditHub (events/audit.py): each entry goes to recordings too
         db.ensure_schema(SCHEMA)
 
     def record(self, panel: str, control: str, label: str, value: Any, result: str, reason: str = "",
                client: str = "") -> dict:
         """Write one entry (committed before returning) and return it as the API shows it."""
+        if self._audit is not None:  # first: a disk that fails the write below must not hide the action
+            self._audit.record(f"{panel}.{result}", by=client, detail=f"{label}: {result}"
+                               + (f" ({reason})" if reason else ""), control=control, value=value_text(value))
         t = time.time()
         with self._db.transaction() as conn:
             cursor = conn.execute(

@@ -74,7 +74,7 @@ class RosAdmin:
         self.safety_nodes = tuple(config["ROVER_WEB_ROS_ADMIN_SAFETY_NODES"])
         # Off: no node of its own at all, so nothing here can reach the graph.
         self.node = AdminNode(rover.runtime) if self.mode != "off" else None
-        self.oplog = oplog or OperatorLog(rover.db, LOG_KEEP)
+        self.oplog = oplog or OperatorLog(rover.db, LOG_KEEP, audit=rover.audit)
         self.goals = GoalBook()
 
     def record(self, control: str, label: str, value: Any, result: str, reason: str, client: str) -> None:

@@ -48,6 +48,7 @@ def init_app(app, fleet: Fleet) -> None:
 def _init_robot(rover: Rover) -> None:
     """Each robot: its own controller, so deadman, operator and re-arming are per robot."""
     teleop = TeleopService(rover, rover.feature(EStopService))
+    teleop.controller.audit = rover.audit  # sessions and who held control, for recordings
     rover.add_feature(teleop)
     rover.hub.register(CHANNEL)
     rover.hub.publish_throttled(CHANNEL, teleop.controller.state(), CHANNEL_MAX_HZ)

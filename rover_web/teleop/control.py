@@ -76,6 +76,7 @@ class TeleopController:
         self._wall = wall_clock
         self._on_state = on_state
         self.request_estop = request_estop  # a socket's {"estop": true}: engages the app's e-stop
+        self.audit = None  # the robot's AuditHub (events/audit.py), set by teleop.init_app: who held control
         self._sessions = Sessions(clock)
         self._holder: Session | None = None  # holds control (sessions.py); a plain attribute: read on every frame
         self._command: Command | None = None
@@ -94,6 +95,7 @@ class TeleopController:
     def connect(self, name: str | None = None) -> Session:
         with self._cond:
             session = self._sessions.open(name)
+            self._audit("teleop.session_open", session)
             self._changed()
             return session
 
@@ -106,6 +108,8 @@ class TeleopController:
             if self._holder is session:
                 self._holder = None
                 self._stop("disconnected")
+                self._audit("teleop.control_end", session, reason="disconnected")
+            self._audit("teleop.session_close", session)
             self._changed()
 
     def takeover(self, session: Session) -> None:
@@ -119,6 +123,7 @@ class TeleopController:
                 raise Refused("estop_engaged", "the e-stop is engaged: nobody takes control until it is released")
             previous = self._holder
             self._holder = session
+            self._audit("teleop.takeover", session, previous=previous.name if previous else None)
             if self._command is not None:
                 self._stop("taken_over")
             if previous is not None:
@@ -135,6 +140,7 @@ class TeleopController:
                 return
             self._holder = None
             self._stop("released")
+            self._audit("teleop.control_end", session, reason="released")
             self._tell(session, "released")
             self._changed()
 
@@ -195,6 +201,7 @@ class TeleopController:
                           f"{1000 * self.deadman_max_s:.0f} ms any input may drive for")
         if self._holder is None:
             self._holder = session
+            self._audit("teleop.control_start", session)
             self._tell(session, "in_control")
         elif self._holder is not session:
             raise Refused("not_in_control", f"{self._holder.name} holds control; you are view-only "
@@ -356,6 +363,11 @@ class TeleopController:
             return self._session_message(session, reason)
 
     # --- internals (called with the lock held) ---
+
+    def _audit(self, action: str, session: Session, **metadata) -> None:
+        if self.audit is not None:
+            self.audit.record(action, by=session.name, detail=f"{action.split('.')[1].replace('_', ' ')}: "
+                              f"{session.name}", session=session.id, **metadata)
 
     def _require_open(self, session: Session) -> None:
         if self._closed:

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from flask import Blueprint, jsonify, render_template, request
 
-from rover_web.core.state import current_feature
+from rover_web.auth import signed_in_name
+from rover_web.core.state import current_feature, current_rover
 from rover_web.geofence import OutsideGeofence, outside_geofence_response
 from rover_web.storage.group_commit import CommitterStopped
 from rover_web.web.http import error_response, json_body
@@ -17,6 +18,17 @@ from .store import EmptyMission, MissionFull, StaleRevision, WaypointNotFound, c
 SQLITE_MAX_INT = (1 << 63) - 1
 
 bp = Blueprint("waypoints", __name__)
+
+
+@bp.after_request
+def _audit_edit(response):
+    # Every accepted change to the mission (add, move, delete, send, import) in one place, for
+    # recordings (events/audit.py): the route and its answer say what was done.
+    if request.method not in ("GET", "HEAD", "OPTIONS") and response.status_code < 400:
+        by = signed_in_name() or request.remote_addr or "unknown"
+        current_rover().audit.record(f"waypoints.{request.endpoint.rsplit('.', 1)[-1]}", by=by,
+                                     detail=f"{request.method} {request.path}", status=response.status_code)
+    return response
 
 
 # --- input ---

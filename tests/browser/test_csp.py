@@ -26,6 +26,7 @@ PAGES = {
     "/diagnostics": [],
     "/ros": [],
     "/robots": [],
+    "/recordings": ["#rec-rows tr"],
     "/plot?topic=/odom&field=twist.twist.linear.x": ["#plot-chart canvas"],
 }
 OTHER_PAGES = {"/api/docs": ".swagger-ui .info", "/login": "form"}  # no event stream on these

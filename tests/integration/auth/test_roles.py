@@ -42,6 +42,9 @@ REQUESTS = [
     ("POST", "/api/actions/goal", {"action": "/nobody", "type": "test_msgs/action/Fibonacci", "goal": {"x": 1}},
      "admin", "/api/actions/goal"),
     ("POST", "/api/actions/" + "0" * 32 + "/cancel", {}, "operator", "/api/actions/<goal_id>/cancel"),
+    ("POST", "/api/recordings", {"topics": "all"}, "operator", "/api/recordings"),
+    ("POST", "/api/recordings/nosuch/stop", {}, "operator", "/api/recordings/<recording_id>/stop"),
+    ("DELETE", "/api/recordings/nosuch", None, "admin", "/api/recordings/<recording_id>"),
     ("POST", "/api/me/sessions/revoke", {}, "viewer", "/api/me/sessions/revoke"),  # tokens stay valid
     ("POST", "/api/camera/whep?topic=/camera/image_raw", {}, "viewer", "/api/camera/whep"),
     ("DELETE", "/api/camera/whep/nosuchsession", None, "viewer", "/api/camera/whep/<session_id>"),
@@ -60,6 +63,9 @@ ANSWERED_WITHOUT_A_PEER = {
     "/api/camera/whep/<session_id>": (404, "unknown_session"),
     # An ack names a stream the caller opened (tests/integration/camera/test_acks.py).
     "/api/camera/viewers/<viewer_id>/ack": (404, "unknown_viewer"),
+    # Stopping or deleting names a recording (tests/integration/recording/test_recording.py).
+    "/api/recordings/<recording_id>/stop": (404, "not_found"),
+    "/api/recordings/<recording_id>": (404, "not_found"),
 }
 RANK = {None: -1, "viewer": 0, "operator": 1, "admin": 2}
 PUBLIC = {("POST", "/login"), ("POST", "/login/estop")}  # tests/integration/estop/test_estop_all.py

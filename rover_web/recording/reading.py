@@ -1,0 +1,69 @@
+"""Reading a recording back, whole or cut short (a SIGKILL or a power loss before its footer).
+
+mcap's seeking reader needs the summary at the end of the file; a recording whose process died
+has none. The non-seeking StreamReader reads records in order from the start and raises EndOfFile
+where the bytes stop: everything before the last complete chunk is there (the writer closes a
+chunk at least every recorder.FLUSH_S), so reading until that point is reading all that survived.
+"""
+
+from __future__ import annotations
+
+import struct
+import zlib
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import zstandard
+from mcap.exceptions import EndOfFile, InvalidMagic, McapError
+from mcap.records import Channel, Footer, Message, Schema
+from mcap.stream_reader import StreamReader
+
+MAGIC = b"\x89MCAP0\r\n"
+# What the stream reader raises where the bytes stop or stop making sense (CRCValidationError is a ValueError).
+CUT_OR_DAMAGED = (EndOfFile, InvalidMagic, McapError, struct.error, zlib.error, zstandard.ZstdError, ValueError)
+
+
+class NotARecording(ValueError):
+    """Not an MCAP file at all, or damaged before its first message; the message says which."""
+
+
+@dataclass
+class Outcome:
+    complete: bool = False  # the footer was read: the file was finished properly
+    messages: int = 0
+
+
+def read_messages(path: Path, outcome: Outcome | None = None) -> Iterator[tuple[Schema | None, Channel, Message]]:
+    """Every message in file order, with its channel and schema; stops quietly at a cut end
+    (outcome.complete says whether the footer was there). NotARecording for anything that is
+    not MCAP; a damaged chunk in the middle ends the reading like a cut."""
+    outcome = outcome if outcome is not None else Outcome()
+    try:
+        with open(path, "rb") as f:
+            if f.read(len(MAGIC)) != MAGIC:
+                raise NotARecording(f"{path} is not an MCAP file (it does not start with the MCAP magic bytes)")
+            f.seek(0)
+            schemas: dict[int, Schema] = {}
+            channels: dict[int, Channel] = {}
+            try:
+                for record in StreamReader(f, validate_crcs=True).records:
+                    if isinstance(record, Schema):
+                        schemas[record.id] = record
+                    elif isinstance(record, Channel):
+                        channels[record.id] = record
+                    elif isinstance(record, Message):
+                        channel = channels.get(record.channel_id)
+                        if channel is None:
+                            continue
+                        outcome.messages += 1
+                        yield schemas.get(channel.schema_id), channel, record
+                    elif isinstance(record, Footer):
+                        outcome.complete = True
+            except CUT_OR_DAMAGED as exc:
+                if outcome.messages == 0 and not channels:
+                    raise NotARecording(f"{path} is damaged before its first message ({type(exc).__name__})") \
+                        from None
+                # Cut short: what came before is what survived.
+    except OSError as exc:
+        raise NotARecording(f"cannot read {path}: {exc.strerror or exc}") from None

@@ -1,0 +1,126 @@
+"""`flask --app rover_web replay FILE`: publish a recording's messages with their original timing.
+
+As `ros2 bag play` does: each message's CDR bytes go out unchanged (rclpy publishes bytes as a
+serialized message), at its recorded log time relative to the first one, divided by --rate. It
+runs its own rclpy context and node (the CLI never starts the app's), so a team can rehearse with
+real data and no robot. The audit channel (/rover_web/audit) is only replayed when named in --topics:
+it was never a ROS topic.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import click
+from flask import Flask, current_app
+
+NODE_NAME = "rover_web_replay"
+AUDIT_TOPIC = "/rover_web/audit"
+
+
+def init_cli(app: Flask) -> None:
+    @app.cli.command("replay")
+    @click.argument("file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+    @click.option("--rate", type=click.FloatRange(0.01, 100), default=1.0, show_default=True,
+                  help="speed: 2 plays twice as fast as recorded")
+    @click.option("--loop", is_flag=True, help="start again from the beginning at the end, until Ctrl-C")
+    @click.option("--topics", multiple=True,
+                  help="only these topics (repeat the option, or separate with commas); default: all but the audit")
+    @click.option("--delay", type=click.FloatRange(0, 60), default=1.0, show_default=True,
+                  help="seconds between making the publishers and the first message, for subscribers to match")
+    def replay(file: Path, rate: float, loop: bool, topics: tuple[str, ...], delay: float):
+        """Publish FILE's messages (an MCAP recording) with their original timing."""
+        from rover_web.recording.reading import NotARecording
+
+        wanted = {t.strip() for entry in topics for t in entry.replace(",", " ").split() if t.strip()}
+        player = _Player(current_app.config.get("ROVER_WEB_ROS_DOMAIN_ID"), rate, wanted, delay)
+        try:
+            while True:
+                cut_short, sent = player.play_once(file)
+                if sent == 0:
+                    shown = ", ".join(sorted(wanted)) if wanted else "any topic"
+                    raise click.ClickException(f"{file}: no message of {shown} to replay")
+                click.echo(f"replayed {sent} messages from {file}")
+                if cut_short:
+                    raise click.ClickException(f"{file} was cut short (no footer): replayed up to its last "
+                                               f"complete chunk")
+                if not loop:
+                    break
+        except NotARecording as exc:
+            raise click.ClickException(str(exc)) from None
+        except KeyboardInterrupt:
+            click.echo("replay stopped")
+        finally:
+            player.close()
+
+
+class _Player:
+    def __init__(self, domain_id: int | None, rate: float, wanted: set[str], delay: float):
+        import rclpy
+        from rclpy.context import Context
+        from rclpy.signals import SignalHandlerOptions
+
+        self.rate = rate
+        self.wanted = wanted
+        self.delay = delay
+        self.context = Context()
+        rclpy.init(context=self.context, domain_id=domain_id, signal_handler_options=SignalHandlerOptions.NO)
+        self.node = rclpy.create_node(NODE_NAME, context=self.context, start_parameter_services=False)
+        self._publishers: dict[int, object] = {}
+        self._skipped: set[str] = set()
+
+    def _publisher(self, schema, channel):
+        from rover_web.ros.typesupport import UnknownMessageType, message_class
+
+        found = self._publishers.get(channel.id)
+        if found is not None or channel.topic in self._skipped:
+            return found
+        if (self.wanted and channel.topic not in self.wanted) or (not self.wanted and channel.topic == AUDIT_TOPIC) \
+                or channel.message_encoding != "cdr" or schema is None:
+            self._skipped.add(channel.topic)
+            return None
+        try:
+            cls = message_class(schema.name)
+        except UnknownMessageType as exc:
+            click.echo(f"skipping {channel.topic}: {exc}", err=True)
+            self._skipped.add(channel.topic)
+            return None
+        publisher = self.node.create_publisher(cls, channel.topic, 10)
+        self._publishers[channel.id] = publisher
+        return publisher
+
+    def play_once(self, file: Path) -> tuple[bool, int]:
+        """(cut short, messages published)."""
+        from rover_web.recording.reading import Outcome, read_messages
+
+        outcome = Outcome()
+        first_log = start = None
+        sent = 0
+        for schema, channel, message in read_messages(file, outcome):
+            publisher = self._publisher(schema, channel)
+            if publisher is None:
+                continue
+            if first_log is None:
+                time.sleep(self.delay)  # publishers made so far get matched before the first message
+                first_log, start = message.log_time, time.monotonic()
+            due = start + (message.log_time - first_log) / 1e9 / self.rate
+            wait = due - time.monotonic()
+            if wait > 0:
+                time.sleep(wait)
+            publisher.publish(message.data)  # bytes: published as the serialized message, unchanged
+            sent += 1
+        return not outcome.complete, sent
+
+    def close(self) -> None:
+        from rclpy.duration import Duration
+
+        for publisher in self._publishers.values():
+            try:  # reliable subscribers get the last messages before the node goes
+                publisher.wait_for_all_acked(Duration(seconds=2))
+            except Exception:  # noqa: BLE001 - best effort: leaving is not an error
+                pass
+        try:
+            self.node.destroy_node()
+        finally:
+            self.context.try_shutdown()

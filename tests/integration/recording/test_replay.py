@@ -1,0 +1,77 @@
+"""`flask --app rover_web replay FILE`: a recording's messages reach a ROS node in another process,
+equal and with their original timing (scaled by --rate); a non-MCAP or cut file is one clear message
+and a non-zero exit."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from rclpy.serialization import serialize_message
+from std_msgs.msg import String
+
+from rover_web.config import ROOT
+from rover_web.recording.recorder import Limits, Recorder
+from tests.support.rospeer import subprocess_env
+
+ROOMY = Limits(max_bytes=10**9, folder_bytes_other=0, folder_max_bytes=10**10, min_free_bytes=0)
+STEP_NS = 200_000_000  # 0.2 s between recorded messages
+N = 8
+
+
+def recording(path, texts, topic="/replay/chatter"):
+    rec = Recorder(path, {topic: "std_msgs/msg/String", "/rover_web/audit": "std_msgs/msg/String"}, limits=ROOMY,
+                   queue_size=100, metadata={"id": "t"})
+    t0 = 1_700_000_000_000_000_000
+    for i, text in enumerate(texts):
+        rec.offer(topic, serialize_message(String(data=text)), t0 + i * STEP_NS)
+    rec.offer("/rover_web/audit", serialize_message(String(data='{"action": "x"}')), t0)
+    rec.stop("requested")
+    return path
+
+
+def replay(*args, timeout=30):
+    return subprocess.run([sys.executable, "-m", "flask", "--app", "rover_web", "replay", *map(str, args)], cwd=ROOT,
+                          env=subprocess_env(), capture_output=True, text=True, timeout=timeout)
+
+
+def test_replay_publishes_every_message_with_its_timing_scaled_by_the_rate(ros_peer, tmp_path):
+    texts = [f"replayed {i}" for i in range(N)]
+    path = recording(tmp_path / "r.mcap", texts)
+    peer = ros_peer("replay_listener")
+    peer.subscribe("/replay/chatter", "std_msgs/msg/String", qos=50)
+    peer.subscribe("/rover_web/audit", "std_msgs/msg/String", qos=50)
+    done = replay(path, "--rate", "2", "--delay", "3")  # time to match on a loaded machine
+    assert done.returncode == 0, done.stderr
+    assert f"replayed {N} messages" in done.stdout
+    peer.wait_for("/replay/chatter", lambda m: m["data"] == texts[-1], timeout=5)  # its stdout lags
+    got = peer.received("/replay/chatter")
+    assert [m["msg"]["data"] for m in got] == texts
+    gaps = [b["t"] - a["t"] for a, b in zip(got, got[1:], strict=False)]
+    # 0.2 s recorded at rate 2: 0.1 s apart; the whole run 0.7 s (a loaded machine adds jitter).
+    assert all(0.05 < gap < 0.25 for gap in gaps), gaps
+    assert 0.6 < got[-1]["t"] - got[0]["t"] < 1.2
+    assert peer.received("/rover_web/audit") == []  # never a ROS topic: not replayed unless asked for
+
+
+def test_a_file_that_is_not_a_recording_is_one_clear_message_and_a_failure(tmp_path):
+    text = tmp_path / "notes.mcap"
+    text.write_text("not a recording\n")
+    done = replay(text)
+    assert done.returncode != 0 and done.stderr.strip().splitlines() == \
+        [f"Error: {text} is not an MCAP file (it does not start with the MCAP magic bytes)"]
+    missing = replay(tmp_path / "missing.mcap")
+    assert missing.returncode != 0 and "does not exist" in missing.stderr
+
+
+def test_a_cut_file_replays_what_survived_and_then_fails_saying_so(tmp_path):
+    whole = recording(tmp_path / "whole.mcap", [f"m{i}" for i in range(3)]).read_bytes()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(whole[:len(whole) - 200])  # the summary and footer are gone, the chunk is there
+    done = replay(cut, "--rate", "100", "--delay", "0")
+    assert done.returncode == 1 and "replayed 3 messages" in done.stdout
+    assert done.stderr.strip() == f"Error: {cut} was cut short (no footer): replayed up to its last complete chunk"
+    head = tmp_path / "head.mcap"
+    head.write_bytes(whole[:60])
+    done = replay(head, "--delay", "0")
+    assert done.returncode == 1 and "damaged before its first message" in done.stderr
