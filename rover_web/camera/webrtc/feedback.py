@@ -26,7 +26,7 @@ from __future__ import annotations
 import time
 from typing import Any
 
-from .bitrate import START_BPS, EncoderBitrate
+from .bitrate import EncoderBitrate
 
 # A resent packet older than this arrives after the browser's jitter buffer has given its frame
 # up (libwebrtc: a few NACK rounds); the radio's deep buffer alone holds about a second.
@@ -59,11 +59,10 @@ def tap_rtcp(session: Any, clock=time.monotonic) -> None:
     from aiortc.rtp import RTCP_PSFB_APP, RTCP_RTPFB_NACK, RtcpPsfbPacket, RtcpRtpfbPacket, unpack_remb_fci
 
     vpx.MIN_BITRATE = min(vpx.MIN_BITRATE, ENCODER_FLOOR_BPS)  # read by the encoder's setter each time
-    vpx.DEFAULT_BITRATE = START_BPS  # read when the encoder is made, at the first frame
     sender = session.sender
     handle = sender._handle_rtcp_packet  # called per RTCP packet by the DTLS transport's router
     last_keyframe = -float("inf")
-    steps = EncoderBitrate(clock=clock)
+    steps = EncoderBitrate(vpx.DEFAULT_BITRATE, clock=clock)  # where aiortc's encoder starts
 
     async def _handle(packet) -> None:
         nonlocal last_keyframe

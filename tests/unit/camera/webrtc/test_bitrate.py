@@ -13,17 +13,17 @@ class Clock:
         return self.t
 
 
-def test_it_starts_low_climbs_only_after_a_hold_and_small_moves_change_nothing():
+def test_it_climbs_at_once_until_the_first_push_back_and_small_moves_change_nothing():
     clock = Clock()
     rate = EncoderBitrate(clock=clock)
-    assert rate.current == START_BPS < 500_000  # not aiortc's 500 kbit/s, a whole radio
-    assert rate.update(2_000_000) == START_BPS  # a first estimate, however high, waits like any climb
-    clock.t += UP_HOLD_S + 0.01
-    assert rate.update(500_000) == 500_000
-    for wanted in (520_000, 480_000, 590_000, 430_000):
+    assert rate.current == START_BPS == 500_000  # aiortc's own start
+    assert rate.update(600_000) == 600_000  # a slow start: each climb taken as it comes
+    clock.t += 0.2
+    assert rate.update(700_000) == 700_000
+    for wanted in (720_000, 680_000, 750_000, 610_000):
         clock.t += 0.3
-        assert rate.update(wanted) == 500_000
-    assert rate.changes == 1
+        assert rate.update(wanted) == 700_000
+    assert rate.changes == 2
 
 
 def test_down_at_once_then_not_again_within_the_interval_unless_it_halves():
@@ -39,9 +39,11 @@ def test_down_at_once_then_not_again_within_the_interval_unless_it_halves():
     assert rate.changes == 3
 
 
-def test_up_only_after_the_estimate_stayed_higher_and_a_dip_restarts_the_wait():
+def test_after_a_push_back_up_only_once_the_estimate_stayed_higher_and_a_dip_restarts_the_wait():
     clock = Clock()
-    rate = EncoderBitrate(300_000, clock=clock)
+    rate = EncoderBitrate(600_000, clock=clock)
+    assert rate.update(300_000) == 300_000  # the link pushed back: the slow start is over
+    clock.t += 5
     assert rate.update(400_000) == 300_000
     clock.t += UP_HOLD_S - 0.5
     assert rate.update(420_000) == 300_000
@@ -51,7 +53,7 @@ def test_up_only_after_the_estimate_stayed_higher_and_a_dip_restarts_the_wait():
     assert rate.update(400_000) == 300_000
     clock.t += UP_HOLD_S + 0.01
     assert rate.update(410_000) == 410_000
-    assert rate.changes == 1
+    assert rate.changes == 2
 
 
 def test_an_estimate_that_jitters_around_a_slow_climb_changes_the_encoder_a_few_times_a_minute():
