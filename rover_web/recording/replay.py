@@ -57,21 +57,17 @@ def init_cli(app: Flask) -> None:
 
 class _Player:
     def __init__(self, domain_id: int | None, rate: float, wanted: set[str], delay: float):
-        import rclpy
-        from rclpy.context import Context
-        from rclpy.signals import SignalHandlerOptions
+        from rover_web.ros.raw import RawPublisherNode
 
         self.rate = rate
         self.wanted = wanted
         self.delay = delay
-        self.context = Context()
-        rclpy.init(context=self.context, domain_id=domain_id, signal_handler_options=SignalHandlerOptions.NO)
-        self.node = rclpy.create_node(NODE_NAME, context=self.context, start_parameter_services=False)
+        self.ros = RawPublisherNode(NODE_NAME, domain_id)
         self._publishers: dict[int, object] = {}
         self._skipped: set[str] = set()
 
     def _publisher(self, schema, channel):
-        from rover_web.ros.typesupport import UnknownMessageType, message_class
+        from rover_web.ros.typesupport import UnknownMessageType
 
         found = self._publishers.get(channel.id)
         if found is not None or channel.topic in self._skipped:
@@ -81,12 +77,11 @@ class _Player:
             self._skipped.add(channel.topic)
             return None
         try:
-            cls = message_class(schema.name)
+            publisher = self.ros.publisher(schema.name, channel.topic)
         except UnknownMessageType as exc:
             click.echo(f"skipping {channel.topic}: {exc}", err=True)
             self._skipped.add(channel.topic)
             return None
-        publisher = self.node.create_publisher(cls, channel.topic, 10)
         self._publishers[channel.id] = publisher
         return publisher
 
@@ -113,14 +108,4 @@ class _Player:
         return not outcome.complete, sent
 
     def close(self) -> None:
-        from rclpy.duration import Duration
-
-        for publisher in self._publishers.values():
-            try:  # reliable subscribers get the last messages before the node goes
-                publisher.wait_for_all_acked(Duration(seconds=2))
-            except Exception:  # noqa: BLE001 - best effort: leaving is not an error
-                pass
-        try:
-            self.node.destroy_node()
-        finally:
-            self.context.try_shutdown()
+        self.ros.close()

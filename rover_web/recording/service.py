@@ -16,11 +16,9 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from rclpy.serialization import serialize_message
-from std_msgs.msg import String
-
 from rover_web.core.state import Rover
 from rover_web.ros.graph import matching_qos, topic_types
+from rover_web.ros.raw import string_cdr
 from rover_web.web.http import ApiError
 
 from .recorder import Limits, Recorder
@@ -221,7 +219,7 @@ class RecordingService:
 
         def audit(record: dict) -> None:
             stamp = record["timestamp"]
-            recorder.offer(AUDIT_TOPIC, serialize_message(String(data=json.dumps(record, separators=(",", ":")))),
+            recorder.offer(AUDIT_TOPIC, string_cdr(json.dumps(record, separators=(",", ":"))),
                            stamp["sec"] * 1_000_000_000 + stamp["nsec"])
         active.unsubscribes = [hub.subscribe(audit) for hub in self._audit_hubs]
 
