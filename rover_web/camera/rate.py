@@ -304,8 +304,11 @@ class ViewerRate:
 
     def path_bps(self) -> float | None:
         """The path's median delivery rate over its last frames (inf when most were not held up),
-        None before the first."""
-        return statistics.median(r for _, r in self._samples) if self._samples else None
+        None before the first. Also read by GET /api/camera/viewers while the stream's thread adds
+        samples: the deque is copied in one step first (tuple() holds the GIL throughout; a
+        generator over it let the other thread in, and CI got "deque mutated during iteration")."""
+        samples = tuple(self._samples)
+        return statistics.median(r for _, r in samples) if samples else None
 
     def _drained(self, now: float, queued: int) -> None:
         started, nbytes, before, _ = self._pending

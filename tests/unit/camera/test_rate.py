@@ -278,3 +278,34 @@ def test_a_fast_path_whose_reader_is_sometimes_busy_keeps_full_rate_and_quality(
         link.bps = 50e6
     assert set(viewer.steps(clock.t - 20)) == {0}
     assert viewer.fps(clock.t - 20, clock.t) > 25
+
+
+def test_the_report_can_be_read_while_the_stream_adds_samples():
+    # GET /api/camera/viewers reads path_bps() on a request thread while the stream's thread adds
+    # drain samples: a generator over the deque let that thread in mid-iteration (CI: "deque mutated
+    # during iteration", a 500). With a tiny switch interval the race shows within a few thousand reads.
+    import sys
+    import threading
+
+    from rover_web.camera.rate import ViewerRate
+
+    rate = ViewerRate(80)
+    stop = threading.Event()
+
+    def add():
+        n = 0
+        while not stop.is_set():
+            n += 1
+            rate._samples.append((n, float(n)))
+
+    writer = threading.Thread(target=add)
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)
+    writer.start()
+    try:
+        for _ in range(20_000):
+            rate.path_bps()
+    finally:
+        stop.set()
+        writer.join()
+        sys.setswitchinterval(interval)
