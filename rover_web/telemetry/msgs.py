@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from rover_web.ros import cdr
 from rover_web.ros.convert import stamp_to_float, yaw_from_quaternion
 
 ODOMETRY = "nav_msgs/msg/Odometry"
@@ -36,4 +37,21 @@ def odom_summary(msg) -> dict:
         "angular": round(twist.angular.z, 3),
         "frame_id": msg.header.frame_id,
         "stamp": stamp_to_float(msg.header.stamp),
+    }
+
+
+def odom_summary_cdr(raw: bytes) -> dict:
+    """odom_summary from the serialized message, reading only the fields shown (ros/cdr.py says why)."""
+    try:
+        f = cdr.odometry(raw)
+    except cdr.NotPlainCdr:
+        return odom_summary(cdr.deserialize(raw, ODOMETRY))
+    return {
+        "x": round(f.x, 3),
+        "y": round(f.y, 3),
+        "yaw": round(yaw_from_quaternion(f.qx, f.qy, f.qz, f.qw), 4),
+        "linear": round(f.linear_x, 3),
+        "angular": round(f.angular_z, 3),
+        "frame_id": f.frame_id,
+        "stamp": f.sec + f.nanosec * 1e-9,
     }
