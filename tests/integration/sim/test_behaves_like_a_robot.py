@@ -114,7 +114,7 @@ def test_the_rover_stops_at_a_wall_and_gives_up_a_goal_behind_it(sim_process, ro
     sim_process("--only", "rover", "--start", str(x0), str(y0), str(math.pi / 2))
     peer = ros_peer()
     peer.subscribe("/odom", "nav_msgs/msg/Odometry")
-    peer.subscribe("/rosout", "rcl_interfaces/msg/Log", qos="latched")
+    peer.subscribe("/rosout", "rcl_interfaces/msg/Log", qos=100)
     peer.advertise("/cmd_vel", "geometry_msgs/msg/Twist")
     peer.wait_for("/odom", timeout=20)
     peer.wait_match("/cmd_vel")
