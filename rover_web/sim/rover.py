@@ -20,6 +20,7 @@ walls (walls.py) and publishes /battery_state from a pack that drains as it driv
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 import os
 import sys
@@ -199,8 +200,8 @@ class RoverSim(Node):
         self._ticks = 0
         self._last = time.monotonic()
         self.create_timer(self._dt, self._tick)
-        # Diagnostics and log lines at every level, once a second, so the demo's /diagnostics and
-        # /logs show something (rclpy nodes log to /rosout).
+        # Diagnostics and the battery once a second, and log lines when something changes, so the
+        # demo's /diagnostics, /logs and Robot card show something (rclpy nodes log to /rosout).
         # Named after the node with its namespace, so an operator reading a merged list knows which robot.
         self.health = HealthModel(node=self.get_fully_qualified_name().lstrip("/"), battery=Battery(battery_charge))
         self.diag_pub = self.create_publisher(DiagnosticArray, "diagnostics", 10)
@@ -341,14 +342,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--goal-speed", type=float, default=0.5, metavar="M_PER_S",
                        help="top speed while driving to a goal or a mission's waypoints")
     group.add_argument("--no-walls", action="store_true",
-                       help="drive through the floorplan's walls (by default the robot stops or slides at the "
-                            "occupied cells of the first map in --maps-file)")
+                       help="drive through the floorplan's walls (by default a rover stops or slides at the "
+                            "occupied cells of the first map in --maps-file; a boat of --robots never meets them)")
     group.add_argument("--battery", type=float, default=100 * START_CHARGE, metavar="PERCENT",
                        help="the battery's charge at start (default %(default)g)")
     group.add_argument("--debug-logs", action="store_true",
                        help="log the health checks at DEBUG every 5 s too (a real node logs at INFO)")
 
 
+@functools.lru_cache(maxsize=4)  # once, not once per robot of --robots
 def first_map(maps_file: str | None = None):
     """The first map the GUI will show: the robot starts on it and meets its walls."""
     from rover_web.livemap.map_files import load_catalog, maps_file_path
@@ -364,9 +366,16 @@ def default_start(maps_file: str | None = None) -> tuple[float, float, float]:
     return first_waypoint_or_centre(first_map(maps_file))
 
 
-def from_arguments(args: argparse.Namespace, context, namespace: str = "/", east_offset_m: float = 0.0) -> RoverSim:
+@functools.lru_cache(maxsize=4)
+def floorplan_walls(maps_file: str | None = None) -> Walls | None:
+    return Walls.of_map(first_map(maps_file))
+
+
+def from_arguments(args: argparse.Namespace, context, namespace: str = "/", east_offset_m: float = 0.0,
+                   kind: str = "") -> RoverSim:
     x, y, yaw = args.start if args.start else default_start(args.maps_file)
-    walls = None if args.no_walls else Walls.of_map(first_map(args.maps_file))
+    # A boat is on the water, where the floorplan is only a picture: its GPS missions cross the park.
+    walls = None if args.no_walls or kind == "boat" else floorplan_walls(args.maps_file)
     return RoverSim(context=context, x=x + east_offset_m, y=y, yaw=yaw, stamped=args.stamped,
                     goal_topic=args.goal_topic, goal_speed_mps=args.goal_speed, namespace=namespace,
                     walls=walls, battery_charge=min(1.0, max(0.0, args.battery / 100)), debug_logs=args.debug_logs)

@@ -2,7 +2,7 @@
 
 The occupied cells of the map image (map_server's trinary reading: `negate`, `occupied_thresh`)
 are grown by the robot's radius once at start, so each step is one array look-up. Unknown cells
-and everything off the image are free: a boat leaves the floorplan for open water, and a robot
+and everything off the image are free: a robot that leaves the floorplan is on open ground, and one
 placed inside a wall (a `--start` there) may drive out of it; only a step from free space into a
 wall is refused.
 """

@@ -131,3 +131,15 @@ def test_the_rover_stops_at_a_wall_and_gives_up_a_goal_behind_it(sim_process, ro
     assert aborted["msg"]["level"] == 30  # WARN: the navigator gave up, nothing is broken
     peer.clear("/odom")
     assert peer.wait_for("/odom")["msg"]["pose"]["pose"]["position"]["y"] < 11.8
+
+
+def test_a_boat_is_on_the_water_where_the_floorplans_walls_are_not(sim_process, ros_peer):
+    x0, y0, _ = default_start()
+    sim_process("--robots", "boat", "--only", "rover", "--start", str(x0), str(y0), str(math.pi / 2))
+    peer = ros_peer()
+    peer.subscribe("/boat/odom", "nav_msgs/msg/Odometry")
+    peer.advertise("/boat/cmd_vel", "geometry_msgs/msg/Twist")
+    peer.wait_for("/boat/odom", timeout=20)
+    peer.wait_match("/boat/cmd_vel")
+    drive(peer, 1.0, 3.0, topic="/boat/cmd_vel")
+    assert peer.wait_for("/boat/odom", lambda m: m["pose"]["pose"]["position"]["y"] > 12.5)  # past y = 12
