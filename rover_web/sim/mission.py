@@ -18,14 +18,7 @@ from collections.abc import Sequence
 
 from std_msgs.msg import Float64MultiArray
 
-EARTH_RADIUS_M = 6378137.0  # the same sphere rover.enu_to_geodetic uses, so the two are exact inverses
-
-
-def geodetic_to_enu(lat: float, lon: float, lat0: float, lon0: float) -> tuple[float, float]:
-    """(metres east, metres north) of (lat, lon) from (lat0, lon0), on the sim's local tangent plane."""
-    y_north = math.radians(lat - lat0) * EARTH_RADIUS_M
-    x_east = math.radians(lon - lon0) * EARTH_RADIUS_M * math.cos(math.radians(lat0))
-    return x_east, y_north
+from .geodesy import geodetic_to_enu
 
 
 def mission_points(data: Sequence[float]) -> list[tuple[float, float]]:

@@ -38,21 +38,14 @@ from rover_web.ros import qos
 from rover_web.ros.convert import quaternion_from_yaw, yaw_from_quaternion
 
 from .battery import START_CHARGE, Battery, battery_state
+from .geodesy import enu_to_geodetic
 from .health import HealthModel
 from .mission import MissionDriver
 from .robots import SPACING_EAST_M
 from .walls import StallWatch, Walls
 
-EARTH_RADIUS_M = 6378137.0
 BENDERSON_LAT = 27.3742443
 BENDERSON_LON = -82.4500873
-
-
-def enu_to_geodetic(x_east_m: float, y_north_m: float, lat0: float, lon0: float) -> tuple[float, float]:
-    """Small-area approximation, good to centimetres over a few kilometres."""
-    lat = lat0 + math.degrees(y_north_m / EARTH_RADIUS_M)
-    lon = lon0 + math.degrees(x_east_m / (EARTH_RADIUS_M * math.cos(math.radians(lat0))))
-    return lat, lon
 
 
 class DiffDrive:

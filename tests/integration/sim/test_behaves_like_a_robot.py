@@ -8,8 +8,8 @@ import time
 import pytest
 import requests
 
-from rover_web.sim.mission import geodetic_to_enu
-from rover_web.sim.rover import BENDERSON_LAT, BENDERSON_LON, default_start, enu_to_geodetic
+from rover_web.sim.geodesy import enu_to_geodetic, geodetic_to_enu
+from rover_web.sim.rover import BENDERSON_LAT, BENDERSON_LON, default_start
 from tests.support.waiting import wait_until
 
 pytestmark = pytest.mark.ros

@@ -4,8 +4,9 @@ import math
 
 import pytest
 
-from rover_web.sim.mission import Mission, geodetic_to_enu, mission_points
-from rover_web.sim.rover import BENDERSON_LAT, BENDERSON_LON, enu_to_geodetic
+from rover_web.sim.geodesy import enu_to_geodetic, geodetic_to_enu
+from rover_web.sim.mission import Mission, mission_points
+from rover_web.sim.rover import BENDERSON_LAT, BENDERSON_LON
 
 
 def test_geodetic_to_enu_inverts_the_fix():
