@@ -1,7 +1,8 @@
 """`python -m rover_web.demo`: the simulator in its own process plus the GUI, stopped by one Ctrl-C.
 
 The simulator is a separate process on purpose: the GUI talks to it over DDS exactly as it would
-talk to a real robot.
+talk to a real robot. The terminal shows what an operator needs (where the GUI is, warnings, errors
+and failed requests); `--verbose` adds a line per request and the simulator's DEBUG lines.
 """
 
 from __future__ import annotations
@@ -12,7 +13,21 @@ import signal
 import subprocess
 import sys
 
+from werkzeug.serving import WSGIRequestHandler
+
 DEMO_GEOFENCE = "map_files/geofence.geojson"
+
+
+class QuietRequestHandler(WSGIRequestHandler):
+    """Only failed requests reach the terminal: an open dashboard alone asks for something every second."""
+
+    def log_request(self, code="-", size="-") -> None:
+        try:
+            failed = int(code) >= 500
+        except (TypeError, ValueError):
+            failed = True
+        if failed:
+            super().log_request(code, size)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -24,10 +39,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--robots", default=None, metavar="NAMES",
                         help="several simulated robots, e.g. boat,rover,drone: each in its own namespace, "
                              "the GUI serves them all (sets ROVER_WEB_ROBOTS)")
+    parser.add_argument("--verbose", action="store_true",
+                        help="print every HTTP request and the simulator's DEBUG lines (off: only what matters)")
     args, sim_args = parser.parse_known_args(argv)
     if args.robots:
         os.environ["ROVER_WEB_ROBOTS"] = args.robots
         sim_args = ["--robots", args.robots, *sim_args]
+    if args.verbose:
+        sim_args = ["--debug-logs", *sim_args]
 
     # Keep the demo's DDS traffic on this machine unless the operator chose otherwise.
     os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
@@ -57,7 +76,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"rover_web: GUI on {scheme}://{'127.0.0.1' if host == '0.0.0.0' else host}:{port}/ "
           f"(ROS domain {os.environ['ROS_DOMAIN_ID']}); Ctrl-C stops the GUI and the simulator", flush=True)
     try:
-        app.run(host=host, port=port, threaded=True, use_reloader=False, ssl_context=tls)
+        app.run(host=host, port=port, threaded=True, use_reloader=False, ssl_context=tls,
+                request_handler=WSGIRequestHandler if args.verbose else QuietRequestHandler)
     except KeyboardInterrupt:
         pass
     finally:

@@ -33,7 +33,9 @@ class CmdVelOutput:
         # frame to the wire (bench/teleop.py).
         self._msg = twist_message(0.0, 0.0, stamped=stamped, frame_id=frame_id)
         self._twist = self._msg.twist if stamped else self._msg
-        self._lock = threading.Lock()
+        # Re-entrant: the process's stop-signal handler (rover_web/process.py) calls halt() on the
+        # main thread, which may be inside halt() already (a second Ctrl-C while stopping).
+        self._lock = threading.RLock()
         self._halted = False
         self._held = False  # the e-stop's hold: only zero goes out until release_hold()
         self.last = (0.0, 0.0)

@@ -36,13 +36,14 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     by_name = {part_name(p): p for p in PARTS}
     if args.robots is None:
-        placements = [(p, "/", 0.0) for p in PARTS if not args.only or part_name(p) in args.only]
+        placements = [(p, "/", 0.0, "") for p in PARTS if not args.only or part_name(p) in args.only]
     else:
-        placements = [(by_name[p.part], p.namespace, p.east_offset_m) for p in plan(args.robots, args.only)]
+        placements = [(by_name[p.part], p.namespace, p.east_offset_m, p.kind) for p in plan(args.robots, args.only)]
         if not placements:
             parser.error("--only leaves none of these robots anything to run")
-    run_nodes(lambda context: [part.from_arguments(args, context, namespace=namespace, east_offset_m=offset)
-                               for part, namespace, offset in placements])
+    run_nodes(lambda context: [part.from_arguments(args, context, namespace=namespace, east_offset_m=offset,
+                                                   **({"kind": kind} if part is rover else {}))
+                               for part, namespace, offset, kind in placements])
 
 
 if __name__ == "__main__":

@@ -8,7 +8,7 @@ kind is written `name:kind`, or taken from the name when it starts with a kind (
 from __future__ import annotations
 
 import argparse
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from rover_web.core import robots as robots_setting
 
@@ -78,6 +78,7 @@ class Placement:
     part: str
     namespace: str
     east_offset_m: float
+    kind: str = field(default="", compare=False)  # a boat is on water: no floorplan walls for it
 
 
 def plan(robots: list[Robot], only: list[str] | None = None) -> list[Placement]:
@@ -92,5 +93,5 @@ def plan(robots: list[Robot], only: list[str] | None = None) -> list[Placement]:
             if part == "rover":
                 offset = drivers * SPACING_EAST_M
                 drivers += 1
-            placements.append(Placement(part, robot.namespace, offset))
+            placements.append(Placement(part, robot.namespace, offset, robot.kind))
     return placements

@@ -12,11 +12,15 @@ drives itself to a goal received on /goal_pose (frame `map`) with a simple turn-
 controller, publishing a straight-line /plan while it goes, and stops there. The operator always
 wins: any /cmd_vel message, a stop included, cancels the goal, as a stop button would on a
 navigating robot.
+
+It also drives a GPS mission sent on /mission (mission.py), stops or slides at the floorplan's
+walls (walls.py) and publishes /battery_state from a pack that drains as it drives (battery.py).
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 import os
 import sys
@@ -28,24 +32,20 @@ from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, Twist, Twi
 from nav_msgs.msg import Odometry, Path
 from rclpy.logging import LoggingSeverity
 from rclpy.node import Node
-from sensor_msgs.msg import NavSatFix, NavSatStatus
+from sensor_msgs.msg import BatteryState, NavSatFix, NavSatStatus
 
 from rover_web.ros import qos
 from rover_web.ros.convert import quaternion_from_yaw, yaw_from_quaternion
 
+from .battery import START_CHARGE, Battery, battery_state
+from .geodesy import enu_to_geodetic
 from .health import HealthModel
+from .mission import MissionDriver
 from .robots import SPACING_EAST_M
+from .walls import StallWatch, Walls
 
-EARTH_RADIUS_M = 6378137.0
 BENDERSON_LAT = 27.3742443
 BENDERSON_LON = -82.4500873
-
-
-def enu_to_geodetic(x_east_m: float, y_north_m: float, lat0: float, lon0: float) -> tuple[float, float]:
-    """Small-area approximation, good to centimetres over a few kilometres."""
-    lat = lat0 + math.degrees(y_north_m / EARTH_RADIUS_M)
-    lon = lon0 + math.degrees(x_east_m / (EARTH_RADIUS_M * math.cos(math.radians(lat0))))
-    return lat, lon
 
 
 class DiffDrive:
@@ -58,6 +58,7 @@ class DiffDrive:
         self.cmd_timeout_s = cmd_timeout_s
         self.max_linear_mps, self.max_angular_rps = max_linear_mps, max_angular_rps
         self.last_cmd_at = -math.inf
+        self.walls: Walls | None = None
 
     def command(self, linear: float, angular: float, now: float) -> None:
         if not (math.isfinite(linear) and math.isfinite(angular)):
@@ -69,6 +70,7 @@ class DiffDrive:
     def step(self, dt: float, now: float) -> None:
         if now - self.last_cmd_at > self.cmd_timeout_s:
             self.linear = self.angular = 0.0
+        x0, y0 = self.x, self.y
         if self.angular == 0.0:
             self.x += self.linear * dt * math.cos(self.yaw)
             self.y += self.linear * dt * math.sin(self.yaw)
@@ -78,6 +80,8 @@ class DiffDrive:
             self.x += radius * (math.sin(new_yaw) - math.sin(self.yaw))
             self.y -= radius * (math.cos(new_yaw) - math.cos(self.yaw))
             self.yaw = math.atan2(math.sin(new_yaw), math.cos(new_yaw))
+        if self.walls is not None:
+            self.x, self.y = self.walls.move(x0, y0, self.x, self.y)
 
 
 def _wrap(angle: float) -> float:
@@ -167,9 +171,12 @@ class RoverSim(Node):
     def __init__(self, *, context=None, x: float = 0.0, y: float = 0.0, yaw: float = 0.0,
                  stamped: bool = False, lat0: float = BENDERSON_LAT, lon0: float = BENDERSON_LON,
                  rate_hz: float = 50.0, goal_topic: str = "goal_pose", goal_speed_mps: float = 0.5,
-                 namespace: str = "/"):
+                 namespace: str = "/", walls: Walls | None = None, battery_charge: float = START_CHARGE,
+                 debug_logs: bool = False):
         super().__init__("sim_rover", namespace=namespace, context=context)
         self.drive = DiffDrive(x, y, yaw)
+        self.drive.walls = walls
+        self.stall = StallWatch()
         self.follower = GoalFollower(max_linear_mps=goal_speed_mps)
         self.lat0, self.lon0 = lat0, lon0
         if stamped:
@@ -181,22 +188,27 @@ class RoverSim(Node):
         self.fix_pub = self.create_publisher(NavSatFix, "fix", 10)
         self.plan_pub = self.create_publisher(Path, "plan", 1)
         self.create_subscription(PoseStamped, goal_topic, self._on_goal, 10)
+        self.mission = MissionDriver(self)
         self._dt = 1.0 / rate_hz
         self._ticks = 0
         self._last = time.monotonic()
         self.create_timer(self._dt, self._tick)
-        # Diagnostics and log lines at every level, once a second, so the demo's /diagnostics and
-        # /logs show something (rclpy nodes log to /rosout).
+        # Diagnostics and the battery once a second, and log lines when something changes, so the
+        # demo's /diagnostics, /logs and Robot card show something (rclpy nodes log to /rosout).
         # Named after the node with its namespace, so an operator reading a merged list knows which robot.
-        self.health = HealthModel(node=self.get_fully_qualified_name().lstrip("/"))
+        self.health = HealthModel(node=self.get_fully_qualified_name().lstrip("/"), battery=Battery(battery_charge))
         self.diag_pub = self.create_publisher(DiagnosticArray, "diagnostics", 10)
-        self.get_logger().set_level(LoggingSeverity.DEBUG)
+        self.battery_pub = self.create_publisher(BatteryState, "battery_state", qos.profile("sensor_data"))
+        # A real node logs at INFO; the health checks' DEBUG lines only with --debug-logs.
+        self.get_logger().set_level(LoggingSeverity.DEBUG if debug_logs else LoggingSeverity.INFO)
         self.create_timer(1.0, self._health)
 
     def _health(self) -> None:
-        statuses, lines = self.health.step()
+        statuses, lines = self.health.step(self.drive.linear, self.drive.angular)
+        statuses.append(self.mission.status(self.health.node))
         msg = DiagnosticArray()
         msg.header.stamp = self.get_clock().now().to_msg()
+        self.battery_pub.publish(battery_state(self.health.battery, msg.header.stamp))
         for s in statuses:
             msg.status.append(DiagnosticStatus(level=bytes([s["level"]]), name=s["name"], message=s["message"],
                                                hardware_id=s["hardware_id"],
@@ -206,6 +218,7 @@ class RoverSim(Node):
             _LOG[level](self.get_logger(), text)
 
     def _on_cmd(self, twist) -> None:
+        self.mission.cancel("operator command on cmd_vel")
         if self.follower.cancel():
             self.get_logger().info("operator command on cmd_vel: goal cancelled")
             self.plan_pub.publish(self._plan(None))
@@ -217,6 +230,7 @@ class RoverSim(Node):
             return
         q = msg.pose.orientation
         x, y = msg.pose.position.x, msg.pose.position.y
+        self.mission.cancel("a new goal")
         if self.follower.set_goal(x, y, yaw_from_quaternion(q.x, q.y, q.z, q.w)):
             self.get_logger().info(f"goal ({x:.2f}, {y:.2f}) received")
             self.plan_pub.publish(self._plan(self.follower.goal))
@@ -227,13 +241,19 @@ class RoverSim(Node):
             d = self.drive
             linear, angular = self.follower.command(d.x, d.y, d.yaw)
             d.command(linear, angular, now)
-            if not self.follower.active:
+            if not self.follower.active and not self.mission.reached():  # else the next waypoint is the goal
                 self.get_logger().info(f"goal reached at ({d.x:.2f}, {d.y:.2f})")
                 self.plan_pub.publish(self._plan(None))
             elif self._ticks % 50 == 0:  # a planner republishes its path; ours shrinks as we go
                 self.plan_pub.publish(self._plan(self.follower.goal))
         self.drive.step(now - self._last, now)
         self._last = now
+        d = self.drive
+        if self.follower.active and self.stall.stalled(d.x, d.y, now, pushing=abs(d.linear) > 0.05):
+            self.follower.cancel()
+            self.get_logger().warning(f"goal aborted: blocked by a wall at ({d.x:.2f}, {d.y:.2f})")
+            self.mission.cancel("blocked by a wall")
+            self.plan_pub.publish(self._plan(None))
         self._ticks += 1
         stamp = self.get_clock().now().to_msg()
         self.odom_pub.publish(self._odom(stamp))
@@ -270,20 +290,21 @@ class RoverSim(Node):
         return msg
 
     def _plan(self, goal: Goal | None) -> Path:
-        """A straight line from here to the goal, or an empty path once there is none."""
+        """Straight lines from here to the goal and on through a mission's later waypoints, or an empty path."""
         msg = Path()
         msg.header.stamp = self.get_clock().now().to_msg()
         msg.header.frame_id = "map"
-        if goal is not None:
-            d = self.drive
-            steps = max(1, int(math.hypot(goal.x - d.x, goal.y - d.y) / 0.25))
-            for i in range(steps + 1):
+        x0, y0 = self.drive.x, self.drive.y
+        for x1, y1 in [] if goal is None else [(goal.x, goal.y), *self.mission.beyond()]:
+            steps = max(1, int(math.hypot(x1 - x0, y1 - y0) / 0.25))
+            for i in range(0 if not msg.poses else 1, steps + 1):
                 pose = PoseStamped()
                 pose.header = msg.header
-                pose.pose.position.x = d.x + (goal.x - d.x) * i / steps
-                pose.pose.position.y = d.y + (goal.y - d.y) * i / steps
+                pose.pose.position.x = x0 + (x1 - x0) * i / steps
+                pose.pose.position.y = y0 + (y1 - y0) * i / steps
                 pose.pose.orientation.w = 1.0
                 msg.poses.append(pose)
+            x0, y0 = x1, y1
         return msg
 
     def _fix(self, stamp) -> NavSatFix:
@@ -312,22 +333,45 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--goal-topic", default="goal_pose",
                        help="PoseStamped goals to drive to (frame map; default goal_pose, in the robot's namespace)")
     group.add_argument("--goal-speed", type=float, default=0.5, metavar="M_PER_S",
-                       help="top speed while driving to a goal")
+                       help="top speed while driving to a goal or a mission's waypoints")
+    group.add_argument("--no-walls", action="store_true",
+                       help="drive through the floorplan's walls (by default a rover stops or slides at the "
+                            "occupied cells of the first map in --maps-file; a boat of --robots never meets them)")
+    group.add_argument("--battery", type=float, default=100 * START_CHARGE, metavar="PERCENT",
+                       help="the battery's charge at start (default %(default)g)")
+    group.add_argument("--debug-logs", action="store_true",
+                       help="log the health checks at DEBUG every 5 s too (a real node logs at INFO)")
+
+
+@functools.lru_cache(maxsize=4)  # once, not once per robot of --robots
+def first_map(maps_file: str | None = None):
+    """The first map the GUI will show: the robot starts on it and meets its walls."""
+    from rover_web.livemap.map_files import load_catalog, maps_file_path
+
+    path = maps_file_path(maps_file or os.environ.get("ROVER_WEB_MAPS_FILE") or "map_files/all_maps.json")
+    return next(iter(load_catalog(path).values()))
 
 
 def default_start(maps_file: str | None = None) -> tuple[float, float, float]:
     """The first waypoint (else the centre) of the first map the GUI will show."""
-    from rover_web.livemap.map_files import first_waypoint_or_centre, load_catalog, maps_file_path
+    from rover_web.livemap.map_files import first_waypoint_or_centre
 
-    path = maps_file_path(maps_file or os.environ.get("ROVER_WEB_MAPS_FILE") or "map_files/all_maps.json")
-    first = next(iter(load_catalog(path).values()))
-    return first_waypoint_or_centre(first)
+    return first_waypoint_or_centre(first_map(maps_file))
 
 
-def from_arguments(args: argparse.Namespace, context, namespace: str = "/", east_offset_m: float = 0.0) -> RoverSim:
+@functools.lru_cache(maxsize=4)
+def floorplan_walls(maps_file: str | None = None) -> Walls | None:
+    return Walls.of_map(first_map(maps_file))
+
+
+def from_arguments(args: argparse.Namespace, context, namespace: str = "/", east_offset_m: float = 0.0,
+                   kind: str = "") -> RoverSim:
     x, y, yaw = args.start if args.start else default_start(args.maps_file)
+    # A boat is on the water, where the floorplan is only a picture: its GPS missions cross the park.
+    walls = None if args.no_walls or kind == "boat" else floorplan_walls(args.maps_file)
     return RoverSim(context=context, x=x + east_offset_m, y=y, yaw=yaw, stamped=args.stamped,
-                    goal_topic=args.goal_topic, goal_speed_mps=args.goal_speed, namespace=namespace)
+                    goal_topic=args.goal_topic, goal_speed_mps=args.goal_speed, namespace=namespace,
+                    walls=walls, battery_charge=min(1.0, max(0.0, args.battery / 100)), debug_logs=args.debug_logs)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -3,6 +3,8 @@
 The publisher is a recorder: what is checked here is what CmdVelOutput hands it, not ROS (the
 ROS side is tests/integration/estop and tests/integration/teleop)."""
 
+import threading
+
 import pytest
 
 pytest.importorskip("geometry_msgs")
@@ -53,4 +55,24 @@ def test_after_halt_only_zero_ever_goes_out():
     out.halt()
     out.release_hold()  # a release after shutdown changes nothing
     out.send(0.5, 0.5)
+    assert sent == [(0.0, 0.0), (0.0, 0.0)]
+
+
+def test_a_stop_signal_arriving_inside_a_publish_does_not_deadlock():
+    """rover_web.process's SIGINT/SIGTERM handler calls halt() on the main thread, which may be inside
+    halt() already (a second Ctrl-C while the demo stops): the demo hung there for good."""
+    out, sent = output()
+    recorder = out._publisher
+    real_publish = recorder.publish
+
+    def publish_then_signal(msg):
+        real_publish(msg)
+        if len(sent) == 1:
+            out.halt()  # what the signal handler does, on the same thread, mid-publish
+
+    recorder.publish = publish_then_signal
+    worker = threading.Thread(target=out.halt, daemon=True)  # a deadlock must fail the test, not hang it
+    worker.start()
+    worker.join(5)
+    assert not worker.is_alive()
     assert sent == [(0.0, 0.0), (0.0, 0.0)]

@@ -57,3 +57,8 @@ def test_only_that_leaves_nothing_to_run_is_refused(capsys):
         main(["--robots", "boat", "--only", "camera"])
     assert exit_.value.code == 2
     assert "leaves none of these robots anything to run" in capsys.readouterr().err
+
+
+def test_each_placement_knows_its_robots_kind():
+    assert [(p.namespace, p.kind) for p in plan(parse_robots("boat,alpha:boat,rover2"), only=["rover"])] == [
+        ("/boat", "boat"), ("/alpha", "boat"), ("/rover2", "rover")]
