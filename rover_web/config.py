@@ -222,7 +222,9 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("GOAL_TOPIC", "/goal_pose", "topic",
             "geometry_msgs/PoseStamped goal, published by the map page and shown when others publish it "
             "(ROS 1: /move_base_simple/goal)"),
-    Setting("GOAL_FRAME_ID", "map", "str", "frame_id of goals sent from the map page"),
+    Setting("GOAL_FRAME_ID", "map", "str", "frame_id of goals and initial poses sent from the map page"),
+    Setting("INITIAL_POSE_TOPIC", "/initialpose", "topic",
+            "geometry_msgs/PoseWithCovarianceStamped the map page's 'Set pose' publishes (AMCL's /initialpose)"),
     Setting("PLAN_TOPIC", "/plan", "topic", "nav_msgs/Path drawn as the robot's route"),
     Setting("LIVEMAP_MAP_TOPIC", None, "optional_topic",
             "nav_msgs/OccupancyGrid (transient local, e.g. /map from SLAM) shown as the map 'live map'; unset: off"),
