@@ -184,6 +184,15 @@ SETTINGS: tuple[Setting, ...] = (
             "std_msgs/Float64MultiArray (n x 2, lng then lat) the whole ordered mission goes to on \"send mission\""),
     Setting("FIX_TOPIC", "/fix", "topic", "sensor_msgs/NavSatFix shown as the robot's marker and track on the map"),
     Setting("MAX_WAYPOINTS", 500, "int", "most waypoints a mission may hold (409 beyond)", 1, 100000),
+    Setting("GPS_HEADING_TOPIC", "/odom", "optional_topic",
+            "the robot's heading on the GPS map: its yaw in an east-aligned frame (REP 105); unset: no heading"),
+    Setting("GPS_HEADING_TYPE", "odometry", "str", "what ROVER_WEB_GPS_HEADING_TOPIC carries: nav_msgs/Odometry, "
+            "sensor_msgs/Imu (with orientation) or geometry_msgs/PoseStamped", choices=("odometry", "imu", "pose")),
+    Setting("GPS_HEADING_OFFSET_DEG", 0.0, "float",
+            "the angle from east to the heading frame's x axis, counter-clockwise (subtracted from the "
+            "bearing drawn)", -360, 360),
+    Setting("GPS_HEADING_STALE_S", 2.0, "float", "the map drops the heading arrow when it is older than this",
+            0.1, 3600),
     Setting("FIX_TRACK_POINTS", 500, "int", "GPS track points kept and drawn behind the robot (oldest dropped)",
             2, 20000),
     Setting("MAP_PLACE_NAME", "Nathan Benderson Park, FL", "str", "name of the place the map opens on"),
