@@ -202,6 +202,9 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("MAP_TILES", "map_files/tiles", "optional_str",
             "offline basemap: a z/x/y tile folder or an .mbtiles file (relative paths from the repository root); "
             "unset or missing means no basemap"),
+    Setting("MAP_GEOJSON_DIR", "map_files/basemap", "optional_str",
+            "drawn basemaps: a folder of <name>.geojson files (land, water, paths; see docs/basemap.md) the GPS map "
+            "draws itself; relative paths from the repository root; unset: none"),
     # --- geofence ---
     Setting("GEOFENCE_MAX_VERTICES", 2000, "int", "most vertices a geofence may have in all (400 beyond)", 4, 100000),
     Setting("GEOFENCE_ESTOP", False, "bool", "engage the e-stop when /fix leaves the geofence"),

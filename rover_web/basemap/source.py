@@ -6,9 +6,11 @@ from pathlib import Path
 
 from rover_web.config import ROOT
 
+from .features import feature_folder
 from .tile_store import TileStoreError, open_tile_store
 
 TILE_URL = "/tiles/{z}/{x}/{y}"
+FEATURES_URL = "/basemap/{name}.geojson"
 
 
 def store_path(config) -> Path | None:
@@ -38,7 +40,14 @@ def map_view(config) -> dict:
         "center": [config["ROVER_WEB_MAP_CENTER_LNG"], config["ROVER_WEB_MAP_CENTER_LAT"]],
         "zoom": config["ROVER_WEB_MAP_ZOOM"],
         "basemap": basemap(config),
+        "features": features(config),
     }
+
+
+def features(config) -> list[dict]:
+    """The drawn (GeoJSON) basemaps the page adds as sources: [{name, url, attribution, bounds}]."""
+    found = feature_folder(config)
+    return found.sources(lambda name: FEATURES_URL.format(name=name)) if found is not None else []
 
 
 def basemap(config) -> dict | None:
