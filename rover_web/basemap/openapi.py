@@ -9,7 +9,7 @@ PATHS = {
                   errors={404: "no such tile, or no basemap installed (an empty body)"},
                   extra={"x-also-media": ["image/jpeg", "image/webp", "application/x-protobuf"]}),
     },
-    "/basemap/{name}.geojson": {
+    "/basemap/{name}": {
         "get": op("A drawn basemap: a GeoJSON FeatureCollection of land, water, paths...", tag="basemap",
                   media="application/geo+json", ok=obj(closed=False),
                   errors={404: "unknown_basemap"}),

@@ -1,5 +1,5 @@
 """GET /tiles/<z>/<x>/<y>: a tile of the installed store, 404 for any tile it does not hold.
-GET /basemap/<name>.geojson: a drawn basemap of ROVER_WEB_MAP_GEOJSON_DIR, checked, 404 otherwise."""
+GET /basemap/<name>: a drawn basemap of ROVER_WEB_MAP_GEOJSON_DIR, checked, 404 otherwise."""
 
 from __future__ import annotations
 
@@ -34,7 +34,7 @@ def tile(z: int, x: int, y: int):
     return response
 
 
-@bp.get("/basemap/<name>.geojson")
+@bp.get("/basemap/<name>")
 def features(name: str):
     found = feature_folder(current_app.config)
     collection = found.get(name) if found is not None else None

@@ -10,7 +10,7 @@ from .features import feature_folder
 from .tile_store import TileStoreError, open_tile_store
 
 TILE_URL = "/tiles/{z}/{x}/{y}"
-FEATURES_URL = "/basemap/{name}.geojson"
+FEATURES_URL = "/basemap/{name}"
 
 
 def store_path(config) -> Path | None:
