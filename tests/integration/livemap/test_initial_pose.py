@@ -125,3 +125,18 @@ def test_the_topic_comes_from_the_setting(live_server_factory, ros_peer):
     response = post(server, {"x": 2.0, "y": 10.5})
     assert response.status_code == 200 and response.json()["topic"] == "/robot1/initialpose"
     peer.wait_for("/robot1/initialpose")
+
+
+def test_the_simulator_takes_the_initial_pose_as_amcl_would(live_server, sim_process):
+    sim_process()
+    at = lambda: requests.get(f"{live_server.url}/api/maps/{B}", timeout=5).json()["map_parameters"]["current_pose"]  # noqa: E731
+    deadline = time.monotonic() + 20
+    while not at():
+        assert time.monotonic() < deadline, "the simulator's pose never arrived"
+        time.sleep(0.2)
+    assert post(live_server, {"x": 30.0, "y": 19.0, "yaw": math.pi}).status_code == 200
+    deadline = time.monotonic() + 10
+    while not (pose := at()) or abs(pose["x"] - 30.0) > 1e-6:
+        assert time.monotonic() < deadline, f"the simulator did not move to the initial pose: {pose}"
+        time.sleep(0.2)
+    assert pose["y"] == pytest.approx(19.0) and abs(pose["yaw"]) == pytest.approx(math.pi, abs=1e-6)
