@@ -24,6 +24,15 @@ from rover_web.core import robots
 # The checkout (or install) root: templates/, static/ and map_files/ are found from here.
 ROOT = Path(__file__).resolve().parent.parent
 
+
+def repo_path(value: str | None) -> Path | None:
+    """A path setting as a path: relative ones start at the repository root; empty means none."""
+    if not value:
+        return None
+    path = Path(value).expanduser()
+    return path if path.is_absolute() else ROOT / path
+
+
 PREFIX = "ROVER_WEB_"
 CONFIG_FILE_VAR = "ROVER_WEB_CONFIG"
 

@@ -18,7 +18,7 @@ import re
 import tempfile
 from pathlib import Path
 
-from rover_web.config import ROOT
+from rover_web.config import repo_path
 from rover_web.web.validate import InvalidInput, loads_strict
 
 log = logging.getLogger(__name__)
@@ -37,11 +37,7 @@ class BadFeatures(ValueError):
 
 
 def folder(config) -> Path | None:
-    value = config.get("ROVER_WEB_MAP_GEOJSON_DIR")
-    if not value:
-        return None
-    path = Path(value).expanduser()
-    return path if path.is_absolute() else ROOT / path
+    return repo_path(config.get("ROVER_WEB_MAP_GEOJSON_DIR"))
 
 
 def _positions(coords, depth: int, where: str, counter: list[int]):

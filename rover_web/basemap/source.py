@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rover_web.config import ROOT
+from rover_web.config import repo_path
 
 from .features import feature_folder
 from .tile_store import TileStoreError, open_tile_store
@@ -14,11 +14,7 @@ FEATURES_URL = "/basemap/{name}"
 
 
 def store_path(config) -> Path | None:
-    value = config.get("ROVER_WEB_MAP_TILES")
-    if not value:
-        return None
-    path = Path(value).expanduser()
-    return path if path.is_absolute() else ROOT / path
+    return repo_path(config.get("ROVER_WEB_MAP_TILES"))
 
 
 def installed_store(config):
