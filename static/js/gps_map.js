@@ -46,16 +46,18 @@ function buildStyle(cfg, sources, layers) {
     sources: { graticule: { type: 'geojson', data: EMPTY }, ...sources },
     layers: [{ id: 'background', type: 'background', paint: { 'background-color': '#17212b' } }],
   };
-  if (cfg.basemap) {
-    const { name, ...source } = cfg.basemap;
-    style.sources.basemap = { type: 'raster', ...source };
-    style.layers.push({ id: 'basemap', type: 'raster', source: 'basemap' });
-  }
+  // Drawn basemaps under the raster tiles: where a store has tiles (imagery, a real survey) they
+  // win; beyond the store's bounds the drawn ones still show.
   const drawn = cfg.features || [];
   drawn.forEach((f, i) => {
     style.sources[`features-${i}`] = { type: 'geojson', data: f.url, attribution: f.attribution };
     style.layers.push(...featureLayers(`features-${i}`));
   });
+  if (cfg.basemap) {
+    const { name, ...source } = cfg.basemap;
+    style.sources.basemap = { type: 'raster', ...source };
+    style.layers.push({ id: 'basemap', type: 'raster', source: 'basemap' });
+  }
   const underlay = cfg.basemap || drawn.length;
   style.layers.push(
     { id: 'graticule', type: 'line', source: 'graticule',
