@@ -48,8 +48,9 @@ def map_pixels(page):
     return np.asarray(Image.open(io.BytesIO(page.locator("#wp-map").screenshot())).convert("RGB")).astype(int)
 
 
-def test_quality_heading_and_accuracy_circle(live_server_factory, ros_peer, page):
-    server = live_server_factory(ROVER_WEB_GPS_HEADING_STALE_S=1.0)
+def test_quality_heading_and_accuracy_circle(live_server_factory, ros_peer, page, tmp_path):
+    # No drawn basemap: the circle's blue is read against the plain background.
+    server = live_server_factory(ROVER_WEB_GPS_HEADING_STALE_S=1.0, ROVER_WEB_MAP_GEOJSON_DIR=str(tmp_path / "none"))
     peer = ros_peer("gps_and_odom")
     peer.advertise("/fix", NAV_SAT_FIX)
     peer.advertise("/odom", ODOMETRY)
