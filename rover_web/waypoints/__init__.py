@@ -44,8 +44,10 @@ def _init_robot(rover: Rover) -> None:
                             lambda msg: service.on_fix(fix_reading(msg)), qos="sensor_data")
     heading_topic, kind = config["ROVER_WEB_GPS_HEADING_TOPIC"], config["ROVER_WEB_GPS_HEADING_TYPE"]
     if heading_topic:
+        # Often /odom, which telemetry already subscribes and counts: counted once.
         rover.runtime.subscribe(HEADING_TYPES[kind], heading_topic,
-                                lambda msg: service.on_heading(heading_yaw(msg, kind)), qos="sensor_data")
+                                lambda msg: service.on_heading(heading_yaw(msg, kind)), qos="sensor_data",
+                                track=not rover.runtime.tracks(heading_topic))
         rover.every(min(0.5, config["ROVER_WEB_GPS_HEADING_STALE_S"] / 2), service.check_heading,
                     name="gps-heading-staleness")
     service.broadcaster.start()
