@@ -61,7 +61,7 @@ class LiveMapService:
     """The maps, the robot track and the goal publisher of one app."""
 
     def __init__(self, rover: Rover, files: dict[str, MapDefinition], goal_publisher, estop: EStopService,
-                 initial_pose_publisher=None):
+                 initial_pose_publisher):
         self.rover = rover
         self.estop = estop
         config = rover.config
