@@ -24,6 +24,15 @@ from rover_web.core import robots
 # The checkout (or install) root: templates/, static/ and map_files/ are found from here.
 ROOT = Path(__file__).resolve().parent.parent
 
+
+def repo_path(value: str | None) -> Path | None:
+    """A path setting as a path: relative ones start at the repository root; empty means none."""
+    if not value:
+        return None
+    path = Path(value).expanduser()
+    return path if path.is_absolute() else ROOT / path
+
+
 PREFIX = "ROVER_WEB_"
 CONFIG_FILE_VAR = "ROVER_WEB_CONFIG"
 
@@ -184,6 +193,15 @@ SETTINGS: tuple[Setting, ...] = (
             "std_msgs/Float64MultiArray (n x 2, lng then lat) the whole ordered mission goes to on \"send mission\""),
     Setting("FIX_TOPIC", "/fix", "topic", "sensor_msgs/NavSatFix shown as the robot's marker and track on the map"),
     Setting("MAX_WAYPOINTS", 500, "int", "most waypoints a mission may hold (409 beyond)", 1, 100000),
+    Setting("GPS_HEADING_TOPIC", "/odom", "optional_topic",
+            "the robot's heading on the GPS map: its yaw in an east-aligned frame (REP 105); unset: no heading"),
+    Setting("GPS_HEADING_TYPE", "odometry", "str", "what ROVER_WEB_GPS_HEADING_TOPIC carries: nav_msgs/Odometry, "
+            "sensor_msgs/Imu (with orientation) or geometry_msgs/PoseStamped", choices=("odometry", "imu", "pose")),
+    Setting("GPS_HEADING_OFFSET_DEG", 0.0, "float",
+            "the angle from east to the heading frame's x axis, counter-clockwise (subtracted from the "
+            "bearing drawn)", -360, 360),
+    Setting("GPS_HEADING_STALE_S", 2.0, "float", "the map drops the heading arrow when it is older than this",
+            0.1, 3600),
     Setting("FIX_TRACK_POINTS", 500, "int", "GPS track points kept and drawn behind the robot (oldest dropped)",
             2, 20000),
     Setting("MAP_PLACE_NAME", "Nathan Benderson Park, FL", "str", "name of the place the map opens on"),
@@ -193,6 +211,9 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("MAP_TILES", "map_files/tiles", "optional_str",
             "offline basemap: a z/x/y tile folder or an .mbtiles file (relative paths from the repository root); "
             "unset or missing means no basemap"),
+    Setting("MAP_GEOJSON_DIR", "map_files/basemap", "optional_str",
+            "drawn basemaps: a folder of <name>.geojson files (land, water, paths; see docs/basemap.md) the GPS map "
+            "draws itself; relative paths from the repository root; unset: none"),
     # --- geofence ---
     Setting("GEOFENCE_MAX_VERTICES", 2000, "int", "most vertices a geofence may have in all (400 beyond)", 4, 100000),
     Setting("GEOFENCE_ESTOP", False, "bool", "engage the e-stop when /fix leaves the geofence"),
@@ -222,7 +243,9 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("GOAL_TOPIC", "/goal_pose", "topic",
             "geometry_msgs/PoseStamped goal, published by the map page and shown when others publish it "
             "(ROS 1: /move_base_simple/goal)"),
-    Setting("GOAL_FRAME_ID", "map", "str", "frame_id of goals sent from the map page"),
+    Setting("GOAL_FRAME_ID", "map", "str", "frame_id of goals and initial poses sent from the map page"),
+    Setting("INITIAL_POSE_TOPIC", "/initialpose", "topic",
+            "geometry_msgs/PoseWithCovarianceStamped the map page's 'Set pose' publishes (AMCL's /initialpose)"),
     Setting("PLAN_TOPIC", "/plan", "topic", "nav_msgs/Path drawn as the robot's route"),
     Setting("LIVEMAP_MAP_TOPIC", None, "optional_topic",
             "nav_msgs/OccupancyGrid (transient local, e.g. /map from SLAM) shown as the map 'live map'; unset: off"),

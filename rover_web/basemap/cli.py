@@ -1,4 +1,4 @@
-"""`flask --app rover_web tiles fetch|info`: fill and inspect the offline basemap, without ROS."""
+"""`flask --app rover_web tiles fetch|import|info`: fill and inspect the offline basemap, without ROS."""
 
 from __future__ import annotations
 
@@ -9,7 +9,10 @@ import click
 from flask import Flask, current_app
 from flask.cli import AppGroup
 
+from .features import feature_folder
+from .features import folder as features_folder
 from .fetch import DEFAULT_MAX_TILES, TooManyTiles, check_url_template, fetch_tiles, parse_bbox, parse_zoom
+from .importer import ImportRefused, import_geojson, import_mbtiles
 from .source import store_path
 from .tile_store import TileStoreError, open_tile_store, tile_count
 
@@ -57,22 +60,64 @@ def init_cli(app: Flask) -> None:
         if result.failed:
             sys.exit(1)
 
+    @tiles.command("import")
+    @click.argument("path", type=click.Path(dir_okay=False, path_type=Path))
+    @click.option("--out", type=click.Path(path_type=Path), default=None,
+                  help="where to: the tile store for an .mbtiles file (default ROVER_WEB_MAP_TILES), the drawn-basemap "
+                       "folder for a .geojson file (default ROVER_WEB_MAP_GEOJSON_DIR)")
+    @click.option("--name", default=None, help="a GeoJSON basemap's name (default: the file's name)")
+    @click.option("--attribution", default="", help="credit line shown on the map (default: the file's own)")
+    @click.option("--force", is_flag=True, help="replace tiles, or a GeoJSON basemap, that are already there")
+    def import_(path, out, name, attribution, force):
+        """Import a basemap made elsewhere: an MBTiles file of raster tiles, or a GeoJSON file of land and water."""
+        suffix = path.suffix.lower()
+        try:
+            if suffix == ".mbtiles":
+                target = out or store_path(current_app.config)
+                if target is None:
+                    raise click.UsageError("ROVER_WEB_MAP_TILES is unset: name a store with --out")
+                store = open_tile_store(target, writable=True)
+                try:
+                    result = import_mbtiles(path, store, force=force, attribution=attribution,
+                                            report=lambda line: click.echo(line, err=True))
+                finally:
+                    store.close()
+                click.echo(f"done: {result.imported} tiles imported, {result.kept} already there; store: {target}")
+            elif suffix in (".geojson", ".json"):
+                root = out or features_folder(current_app.config)
+                if root is None:
+                    raise click.UsageError("ROVER_WEB_MAP_GEOJSON_DIR is unset: name a folder with --out")
+                folder = feature_folder({"ROVER_WEB_MAP_GEOJSON_DIR": str(root)})
+                written = import_geojson(path, folder, name=name, attribution=attribution, force=force)
+                click.echo(f"done: {written} (drawn on the GPS map)")
+            else:
+                raise click.UsageError(f"{path}: import takes an .mbtiles file or a .geojson (or .json) file")
+        except (ImportRefused, TileStoreError) as exc:
+            raise click.ClickException(str(exc)) from None
+
     @tiles.command("info")
     def info():
-        """Show the configured tile store: where, what kind, zoom levels, bounds."""
-        path = store_path(current_app.config)
-        if path is None:
-            click.echo("ROVER_WEB_MAP_TILES is unset: no basemap")
-            return
-        store = open_tile_store(path)
-        try:
-            if not store.exists():
-                click.echo(f"{path}: no tiles there yet (the map shows no basemap)")
-                return
-            meta = store.metadata()
-        finally:
-            store.close()
-        click.echo(f"{path} ({store.kind}): zoom {meta['minzoom']}-{meta['maxzoom']}, bounds {meta['bounds']}, "
-                   f"attribution {meta['attribution']!r}")
+        """Show the basemaps: the tile store (where, what kind, zoom levels, bounds) and the drawn ones."""
+        click.echo(_store_line(store_path(current_app.config)))
+        drawn = feature_folder(current_app.config)
+        for name in drawn.names() if drawn is not None else ():
+            collection = drawn.get(name)
+            click.echo(f"drawn basemap {name} ({drawn.root}): " + (
+                f"{len(collection['features'])} features, bounds {collection['bbox']}, attribution "
+                f"{collection.get('attribution', '')!r}" if collection else "not valid, left out (see the log)"))
 
     app.cli.add_command(tiles)
+
+
+def _store_line(path: Path | None) -> str:
+    if path is None:
+        return "ROVER_WEB_MAP_TILES is unset: no tile basemap"
+    store = open_tile_store(path)
+    try:
+        if not store.exists():
+            return f"{path}: no tiles there yet"
+        meta = store.metadata()
+    finally:
+        store.close()
+    return (f"{path} ({store.kind}): zoom {meta['minzoom']}-{meta['maxzoom']}, bounds {meta['bounds']}, "
+            f"attribution {meta['attribution']!r}")

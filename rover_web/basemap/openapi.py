@@ -1,6 +1,6 @@
 """The offline tiles route, for GET /api/openapi.json (see rover_web/apidocs/describe.py)."""
 
-from rover_web.apidocs.describe import op
+from rover_web.apidocs.describe import obj, op
 
 PATHS = {
     "/tiles/{z}/{x}/{y}": {
@@ -8,5 +8,10 @@ PATHS = {
                   media="image/png", ok={"type": "string", "contentMediaType": "image/png"},
                   errors={404: "no such tile, or no basemap installed (an empty body)"},
                   extra={"x-also-media": ["image/jpeg", "image/webp", "application/x-protobuf"]}),
+    },
+    "/basemap/{name}": {
+        "get": op("A drawn basemap: a GeoJSON FeatureCollection of land, water, paths...", tag="basemap",
+                  media="application/geo+json", ok=obj(closed=False),
+                  errors={404: "unknown_basemap"}),
     },
 }

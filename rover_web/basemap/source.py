@@ -4,19 +4,17 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rover_web.config import ROOT
+from rover_web.config import repo_path
 
+from .features import feature_folder
 from .tile_store import TileStoreError, open_tile_store
 
 TILE_URL = "/tiles/{z}/{x}/{y}"
+FEATURES_URL = "/basemap/{name}"
 
 
 def store_path(config) -> Path | None:
-    value = config.get("ROVER_WEB_MAP_TILES")
-    if not value:
-        return None
-    path = Path(value).expanduser()
-    return path if path.is_absolute() else ROOT / path
+    return repo_path(config.get("ROVER_WEB_MAP_TILES"))
 
 
 def installed_store(config):
@@ -38,7 +36,14 @@ def map_view(config) -> dict:
         "center": [config["ROVER_WEB_MAP_CENTER_LNG"], config["ROVER_WEB_MAP_CENTER_LAT"]],
         "zoom": config["ROVER_WEB_MAP_ZOOM"],
         "basemap": basemap(config),
+        "features": features(config),
     }
+
+
+def features(config) -> list[dict]:
+    """The drawn (GeoJSON) basemaps the page adds as sources: [{name, url, attribution, bounds}]."""
+    found = feature_folder(config)
+    return found.sources(lambda name: FEATURES_URL.format(name=name)) if found is not None else []
 
 
 def basemap(config) -> dict | None:

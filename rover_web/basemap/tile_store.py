@@ -275,7 +275,7 @@ class MBTiles:
             "minzoom": str(minzoom if old_min is None else min(minzoom, old_min)),
             "maxzoom": str(maxzoom if old_max is None else max(maxzoom, old_max)),
             "attribution": attribution or old.get("attribution", ""),
-            "description": f"fetched from {source}",
+            "description": f"tiles from {source}",
         }
         conn = self._connect()
         with_tx(conn, lambda: conn.executemany("INSERT OR REPLACE INTO metadata (name, value) VALUES (?, ?)",

@@ -7,6 +7,7 @@
   GET  /api/status      the hub's own state: fleet, robots heard, dropped forged summaries
   GET  /api/openapi.json  these routes described
   GET  /tiles/<z>/<x>/<y>  the installed basemap's tiles, for the page's map (rover_web/basemap)
+  GET  /basemap/<name>   a drawn (GeoJSON) basemap, for the same map
 Sign-in, users, tokens and roles are rover_web/auth's, as on a robot, in the hub's own database.
 
 The hub is no ROS node: create() is called before rover_web imports rclpy, and nothing here

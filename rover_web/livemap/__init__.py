@@ -1,11 +1,12 @@
 """LiveMap: floorplans from map_files, the live robot pose, its goal and plan, click-to-goal.
 
 ROS: subscribes /amcl_pose (transient local), /goal_pose, /plan and optionally an OccupancyGrid
-(/map, transient local) drawn into a map named "live map"; publishes goals on /goal_pose.
+(/map, transient local) drawn into a map named "live map"; publishes goals on /goal_pose and the
+operator's initial pose on /initialpose.
 SSE: `pose` (at most LIVEMAP_POSE_MAX_HZ), `goal`, `plan` (at most 5 Hz), `live_map` (new grid).
 HTTP: /livemap pages and /api/maps... (see routes.py and README.md).
 Modules: service (the per-app object), routes, state (LiveMap and the robot's track), map_files,
-geometry, occupancy, msgs.
+geometry, occupancy, initial_pose (its input), msgs.
 """
 
 from __future__ import annotations
@@ -29,7 +30,8 @@ def _init_robot(rover: Rover) -> None:
     files = load_files(config)
     runtime = rover.runtime
     goal_publisher = runtime.publisher(msgs.POSE_STAMPED, config["ROVER_WEB_GOAL_TOPIC"], "default")
-    service = LiveMapService(rover, files, goal_publisher, rover.feature(EStopService))
+    initial_pose_publisher = runtime.publisher(msgs.AMCL_POSE, config["ROVER_WEB_INITIAL_POSE_TOPIC"], "default")
+    service = LiveMapService(rover, files, goal_publisher, rover.feature(EStopService), initial_pose_publisher)
     rover.add_feature(service)
 
     rover.hub.register("pose", "goal", "plan", "live_map")

@@ -43,6 +43,18 @@ def goal_message(x: float, y: float, yaw: float, frame_id: str, stamp):
     return msg
 
 
+def initial_pose_message(x: float, y: float, yaw: float, covariance, frame_id: str, stamp):
+    """A fresh PoseWithCovarianceStamped for /initialpose (what RViz's 2D Pose Estimate sends)."""
+    msg = message_class(AMCL_POSE)()
+    msg.header.stamp = stamp
+    msg.header.frame_id = frame_id
+    msg.pose.pose.position.x, msg.pose.pose.position.y = float(x), float(y)
+    o = msg.pose.pose.orientation
+    o.x, o.y, o.z, o.w = quaternion_from_yaw(yaw)
+    msg.pose.covariance = [float(v) for v in covariance]
+    return msg
+
+
 def path_points(msg) -> tuple[str, list[tuple[float, float]]]:
     """(frame_id, [(x, y), ...]) of a nav_msgs/Path."""
     return msg.header.frame_id, [(p.pose.position.x, p.pose.position.y) for p in msg.poses]

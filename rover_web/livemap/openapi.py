@@ -28,4 +28,15 @@ PATHS = {
                                 "outside_map", **UNKNOWN, 409: "estop_engaged",
                            422: "outside_geofence (reason inside_keep_out)", 503: "shutting_down"}),
     },
+    "/api/maps/{name}/initial_pose": {
+        "post": op("Set the robot's initial pose (AMCL's /initialpose) in the map's frame", tag="livemap",
+                   role="operator", ok=obj(closed=False),
+                   body=obj({"x": {"type": "number"}, "y": {"type": "number"}, "yaw": {"type": "number"},
+                             "covariance": {"type": "array", "items": {"type": "number"},
+                                            "minItems": 36, "maxItems": 36}},
+                            ("x", "y")),
+                   errors={400: "missing_body, bad_json, non_finite, unknown_field, missing_field, bad_type, "
+                                "out_of_range, bad_value, outside_map", **UNKNOWN, 409: "estop_engaged",
+                           503: "shutting_down"}),
+    },
 }

@@ -12,6 +12,7 @@ from rover_web.geofence import OutsideGeofence, outside_geofence_response
 from rover_web.web.http import ApiError, error_response, json_body
 from rover_web.web.validate import InvalidInput, number, only_keys
 
+from . import initial_pose
 from .map_files import MapDefinition
 from .service import LIVE_MAP_NAME, LiveMapService, OutsideMap, ShuttingDown
 from .state import UnknownMap, goal_payload
@@ -54,7 +55,8 @@ def map_summary(definition: MapDefinition) -> dict:
         # Under the robot's prefix (/robots/<name>): a live map is that robot's own.
         "urls": {"state": f"{root}/api/maps/{quoted}", "image": f"{root}/api/maps/{quoted}/image{version}",
                  "thumbnail": f"{root}/api/maps/{quoted}/thumbnail{version}", "page": f"{root}/livemap/{quoted}",
-                 "goal": f"{root}/api/maps/{quoted}/goal"},
+                 "goal": f"{root}/api/maps/{quoted}/goal",
+                 "initial_pose": f"{root}/api/maps/{quoted}/initial_pose"},
     }
 
 
@@ -105,6 +107,7 @@ def livemap_page(name: str):
         "plan": feature.track.plan(),
         "pose_stale_s": feature.track.stale_after_s,
         "goal_topic": feature.goal_topic,
+        "initial_pose_topic": feature.initial_pose_topic,
     }
     return render_template("livemap.html", page=page, maps=page["maps"])
 
@@ -161,3 +164,16 @@ def post_goal(name: str):
     goal = feature.send_goal(definition, x, y, yaw)
     payload = goal_payload(goal, [definition])
     return jsonify(status="sent", topic=feature.goal_topic, goal=payload)
+
+
+@bp.post("/api/maps/<name>/initial_pose")
+def post_initial_pose(name: str):
+    feature = current_feature(LiveMapService)
+    definition = feature.get(name)
+    body = json_body()
+    try:
+        x, y, yaw, covariance = initial_pose.parse(body)
+    except InvalidInput as exc:
+        raise ApiError(400, exc.code, str(exc)) from None
+    sent = feature.send_initial_pose(definition, x, y, yaw, covariance)
+    return jsonify(status="sent", topic=feature.initial_pose_topic, initial_pose=sent)

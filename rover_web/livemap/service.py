@@ -48,10 +48,20 @@ def load_files(config: dict[str, Any]) -> dict[str, MapDefinition]:
     return files
 
 
+def check_on_map(definition: MapDefinition, x: float, y: float) -> None:
+    if not definition.geometry.contains(x, y):
+        g = definition.geometry
+        corners = [g.pixel_to_world(*c) for c in ((0, g.height_px), (g.width_px, 0))]
+        raise OutsideMap(f"({x:g}, {y:g}) is outside {definition.name!r}, which spans "
+                         f"x {min(corners[0][0], corners[1][0]):g}..{max(corners[0][0], corners[1][0]):g} m, "
+                         f"y {min(corners[0][1], corners[1][1]):g}..{max(corners[0][1], corners[1][1]):g} m")
+
+
 class LiveMapService:
     """The maps, the robot track and the goal publisher of one app."""
 
-    def __init__(self, rover: Rover, files: dict[str, MapDefinition], goal_publisher, estop: EStopService):
+    def __init__(self, rover: Rover, files: dict[str, MapDefinition], goal_publisher, estop: EStopService,
+                 initial_pose_publisher):
         self.rover = rover
         self.estop = estop
         config = rover.config
@@ -68,6 +78,8 @@ class LiveMapService:
         self.default_name = config["ROVER_WEB_LIVEMAP_DEFAULT_MAP"] or next(iter(files), None) \
             or (LIVE_MAP_NAME if self.map_topic else None)
         self._goal_publisher = goal_publisher
+        self._initial_pose_publisher = initial_pose_publisher
+        self.initial_pose_topic = config["ROVER_WEB_INITIAL_POSE_TOPIC"]
         self._goal_lock = threading.Lock()
         self._was_stale = True  # no pose yet counts as stale: nothing to announce
 
@@ -152,12 +164,7 @@ class LiveMapService:
 
     def send_goal(self, definition: MapDefinition, x: float, y: float, yaw: float) -> Pose2D:
         """Publish a goal on the map; OutsideMap or ShuttingDown when nothing was sent."""
-        if not definition.geometry.contains(x, y):
-            g = definition.geometry
-            corners = [g.pixel_to_world(*c) for c in ((0, g.height_px), (g.width_px, 0))]
-            raise OutsideMap(f"({x:g}, {y:g}) is outside {definition.name!r}, which spans "
-                             f"x {min(corners[0][0], corners[1][0]):g}..{max(corners[0][0], corners[1][0]):g} m, "
-                             f"y {min(corners[0][1], corners[1][1]):g}..{max(corners[0][1], corners[1][1]):g} m")
+        check_on_map(definition, x, y)
         check_goal(definition.keep_out, definition.name, x, y)  # OutsideGeofence: 422, nothing sent
         if self.rover.stopping.is_set():
             raise ShuttingDown("the server is shutting down; no goal was sent")
@@ -171,6 +178,24 @@ class LiveMapService:
             if self.track.set_goal(goal):
                 self.rover.hub.publish("goal", goal_payload(goal, self.maps()))
         return goal
+
+    def send_initial_pose(self, definition: MapDefinition, x: float, y: float, yaw: float,
+                          covariance) -> dict:
+        """Tell the localiser where the robot is; OutsideMap, EStopEngaged or ShuttingDown when nothing was sent.
+
+        Refused during an e-stop as goals are: a new pose makes AMCL jump, and Nav2 replans from it.
+        Keep-out areas are not checked: the robot may well stand in one (it was carried there).
+        """
+        check_on_map(definition, x, y)
+        if self.rover.stopping.is_set():
+            raise ShuttingDown("the server is shutting down; no initial pose was sent")
+        self.estop.check_motion()
+        yaw = wrap_angle(yaw)
+        stamp = self.rover.runtime.now_msg()
+        self._initial_pose_publisher.publish(
+            msgs.initial_pose_message(x, y, yaw, covariance, self.goal_frame_id, stamp))
+        return {"x": x, "y": y, "yaw": round(yaw, 6), "frame_id": self.goal_frame_id,
+                "stamp": msgs.stamp_seconds(stamp), "covariance": list(covariance)}
 
     # --- staleness ---
 

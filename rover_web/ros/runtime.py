@@ -175,6 +175,10 @@ class RosRuntime:
         """The node clock's current time as builtin_interfaces/Time, for stamping headers."""
         return self.node.get_clock().now().to_msg()
 
+    def tracks(self, topic: str) -> bool:
+        """Whether a subscription already counts `topic`'s messages for /api/status (a second would double its rate)."""
+        return topic in self._stats
+
     def topic_stats(self, stale_after_s: float, under: str = "") -> list[dict]:
         """Every tracked topic, or those under the namespace `under` (one robot's, of several)."""
         now = time.monotonic()

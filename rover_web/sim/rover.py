@@ -7,7 +7,8 @@ Like a real base it stops by itself when commands stop for `cmd_timeout_s`. Its 
 map pose laid on a local tangent plane around a configurable origin (by default Nathan
 Benderson Park, Sarasota, FL, where RobotX is held).
 
-It starts on the first floorplan of map_files/all_maps.json (at that map's first waypoint) and
+It starts on the first floorplan of map_files/all_maps.json (at that map's first waypoint), jumps
+to an initial pose on /initialpose (as AMCL would re-localise; it has no odometry drift), and
 drives itself to a goal received on /goal_pose (frame `map`) with a simple turn-and-drive
 controller, publishing a straight-line /plan while it goes, and stops there. The operator always
 wins: any /cmd_vel message, a stop included, cancels the goal, as a stop button would on a
@@ -189,6 +190,8 @@ class RoverSim(Node):
         self.plan_pub = self.create_publisher(Path, "plan", 1)
         self.create_subscription(PoseStamped, goal_topic, self._on_goal, 10)
         self.mission = MissionDriver(self)
+        # Standing in for AMCL: an operator's initial pose (LiveMap's Set pose) puts the robot there.
+        self.create_subscription(PoseWithCovarianceStamped, "initialpose", self._on_initial_pose, 10)
         self._dt = 1.0 / rate_hz
         self._ticks = 0
         self._last = time.monotonic()
@@ -234,6 +237,16 @@ class RoverSim(Node):
         if self.follower.set_goal(x, y, yaw_from_quaternion(q.x, q.y, q.z, q.w)):
             self.get_logger().info(f"goal ({x:.2f}, {y:.2f}) received")
             self.plan_pub.publish(self._plan(self.follower.goal))
+
+    def _on_initial_pose(self, msg: PoseWithCovarianceStamped) -> None:
+        p, q = msg.pose.pose.position, msg.pose.pose.orientation
+        yaw = yaw_from_quaternion(q.x, q.y, q.z, q.w)
+        if msg.header.frame_id not in ("map", "") or not all(map(math.isfinite, (p.x, p.y, yaw))):
+            self.get_logger().warning("ignoring an initial pose that is not a finite pose in frame 'map'")
+            return
+        d = self.drive
+        d.x, d.y, d.yaw = p.x, p.y, yaw
+        self.get_logger().info(f"initial pose set: ({p.x:.2f}, {p.y:.2f}), {math.degrees(yaw):.0f} degrees")
 
     def _tick(self) -> None:
         now = time.monotonic()

@@ -7,8 +7,9 @@ HTTP (routes.py; the rules live in store, geojson and gps):
   PATCH/DELETE /api/waypoints/<id>     move (lng/lat), rename (label), reorder (index), delete
   POST /api/waypoints/send             the whole ordered mission on /mission (n x 2 Float64MultiArray)
   GET/POST /api/waypoints/geojson      export / import (replace) as a GeoJSON FeatureCollection
-SSE: `waypoints` (the stored mission, at most 10 Hz, broadcaster.py) and `fix` (robot position and
-track, 5 Hz, from NavSatFix on ROVER_WEB_FIX_TOPIC).
+SSE: `waypoints` (the stored mission, at most 10 Hz, broadcaster.py), `fix` (robot position, fix
+quality, accuracy and track, 5 Hz, from NavSatFix on ROVER_WEB_FIX_TOPIC) and `heading` (compass
+bearing, 10 Hz, from ROVER_WEB_GPS_HEADING_TOPIC; heading.py).
 
 Every waypoint added, by either POST, is stored (committed, fsynced) first and then published on
 /waypoints, so an acknowledged waypoint is both on disk and on the wire. Moves, reorders, deletes
@@ -23,8 +24,8 @@ from rover_web.estop import EStopService
 from rover_web.geofence import GeofenceService
 
 from . import broadcaster, routes
-from .msgs import NAV_SAT_FIX, fix_reading
-from .service import FIX_CHANNEL, WaypointsService
+from .msgs import HEADING_TYPES, NAV_SAT_FIX, fix_reading, heading_yaw
+from .service import FIX_CHANNEL, HEADING_CHANNEL, WaypointsService
 
 
 def init_app(app, fleet: Fleet) -> None:
@@ -37,11 +38,21 @@ def init_app(app, fleet: Fleet) -> None:
 def _init_robot(rover: Rover) -> None:
     service = WaypointsService(rover, rover.feature(EStopService), rover.feature(GeofenceService))
     rover.add_feature(service)
-    rover.hub.register(broadcaster.CHANNEL, FIX_CHANNEL)
-    rover.runtime.subscribe(NAV_SAT_FIX, rover.config["ROVER_WEB_FIX_TOPIC"],
+    rover.hub.register(broadcaster.CHANNEL, FIX_CHANNEL, HEADING_CHANNEL)
+    config = rover.config
+    rover.runtime.subscribe(NAV_SAT_FIX, config["ROVER_WEB_FIX_TOPIC"],
                             lambda msg: service.on_fix(fix_reading(msg)), qos="sensor_data")
+    heading_topic, kind = config["ROVER_WEB_GPS_HEADING_TOPIC"], config["ROVER_WEB_GPS_HEADING_TYPE"]
+    if heading_topic:
+        # Often /odom, which telemetry already subscribes and counts: counted once.
+        rover.runtime.subscribe(HEADING_TYPES[kind], heading_topic,
+                                lambda msg: service.on_heading(heading_yaw(msg, kind)), qos="sensor_data",
+                                track=not rover.runtime.tracks(heading_topic))
+        rover.every(min(0.5, config["ROVER_WEB_GPS_HEADING_STALE_S"] / 2), service.check_heading,
+                    name="gps-heading-staleness")
     service.broadcaster.start()
     rover.on_shutdown(service.broadcaster.stop)
     rover.on_shutdown(service.store.close)  # runs first: queued changes commit before the db closes
-    rover.add_panel(20, "panels/waypoints.html", "GPS waypoints", channels=(broadcaster.CHANNEL, FIX_CHANNEL))
+    rover.add_panel(20, "panels/waypoints.html", "GPS waypoints",
+                    channels=(broadcaster.CHANNEL, FIX_CHANNEL, HEADING_CHANNEL))
     rover.add_nav("Waypoints", "/waypoints")

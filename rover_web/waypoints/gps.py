@@ -16,6 +16,9 @@ from dataclasses import dataclass
 EARTH_RADIUS_M = 6371008.8
 STATUS_NO_FIX = -1  # sensor_msgs/NavSatStatus.STATUS_NO_FIX
 STATUS_NAMES = {-1: "no fix", 0: "fix", 1: "SBAS fix", 2: "GBAS fix"}
+# A word per NavSatStatus the page styles by: unaugmented, satellite-based augmentation (WAAS,
+# EGNOS), ground-based augmentation (DGPS, RTK).
+QUALITY = {-1: "none", 0: "fix", 1: "sbas", 2: "gbas"}
 
 
 @dataclass(frozen=True)
@@ -73,6 +76,7 @@ class GpsTrack:
                 "reason": reason,
                 "status": reading.status,
                 "status_text": STATUS_NAMES.get(reading.status, f"status {reading.status}"),
+                "quality": QUALITY.get(reading.status, "none" if reading.status < 0 else "fix") if fix else "none",
                 "lng": round(reading.lng, 8) if fix else None,
                 "lat": round(reading.lat, 8) if fix else None,
                 "alt": _finite_or_none(reading.alt, 2) if fix else None,

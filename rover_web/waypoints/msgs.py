@@ -8,9 +8,13 @@ from collections.abc import Sequence
 from rover_web.ros.typesupport import message_class
 
 from .gps import FixReading
+from .heading import yaw_of_quaternion
 
 FLOAT64_MULTI_ARRAY = "std_msgs/msg/Float64MultiArray"
 NAV_SAT_FIX = "sensor_msgs/msg/NavSatFix"
+# ROVER_WEB_GPS_HEADING_TYPE -> the message type its topic carries
+HEADING_TYPES = {"odometry": "nav_msgs/msg/Odometry", "imu": "sensor_msgs/msg/Imu",
+                 "pose": "geometry_msgs/msg/PoseStamped"}
 
 
 def waypoint_message(lng: float, lat: float):
@@ -47,3 +51,16 @@ def fix_reading(msg) -> FixReading:
             sigma = math.sqrt((east + north) / 2)
     return FixReading(status=int(msg.status.status), lat=float(msg.latitude), lng=float(msg.longitude),
                       alt=float(msg.altitude), horizontal_sigma_m=sigma)
+
+
+def heading_yaw(msg, kind: str) -> float | None:
+    """Yaw (radians, ENU) of an Odometry, Imu or PoseStamped; None when it carries no orientation."""
+    if kind == "imu":
+        if msg.orientation_covariance[0] == -1.0:  # REP 145: this IMU gives no orientation
+            return None
+        q = msg.orientation
+    elif kind == "odometry":
+        q = msg.pose.pose.orientation
+    else:
+        q = msg.pose.orientation
+    return yaw_of_quaternion(float(q.x), float(q.y), float(q.z), float(q.w))

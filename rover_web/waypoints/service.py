@@ -11,11 +11,14 @@ from rover_web.geofence import GeofenceService, OutsideGeofence
 
 from .broadcaster import MissionBroadcaster
 from .gps import FixReading, GpsTrack
+from .heading import Heading
 from .msgs import FLOAT64_MULTI_ARRAY, mission_message, waypoint_message
 from .store import EmptyMission, Mission, StaleRevision, Waypoint, WaypointStore
 
 FIX_CHANNEL = "fix"
 FIX_CHANNEL_MAX_HZ = 5.0
+HEADING_CHANNEL = "heading"
+HEADING_CHANNEL_MAX_HZ = 10.0
 # Every waypoint is a command the robot must not miss: keep enough history that a subscriber a
 # few hundred milliseconds behind a burst of clicks (or a script) still receives all of them.
 log = logging.getLogger(__name__)
@@ -37,6 +40,8 @@ class WaypointsService:
         self.mission_pub = runtime.publisher(FLOAT64_MULTI_ARRAY, self.mission_topic, qos=10)
         self.hub = rover.hub
         self.track = GpsTrack(config["ROVER_WEB_FIX_TRACK_POINTS"])
+        self.heading = Heading(config["ROVER_WEB_GPS_HEADING_TOPIC"], config["ROVER_WEB_GPS_HEADING_OFFSET_DEG"],
+                               config["ROVER_WEB_GPS_HEADING_STALE_S"])
         self.broadcaster = MissionBroadcaster(self.store, rover.hub)
 
     def on_fix(self, reading: FixReading) -> None:
@@ -44,6 +49,16 @@ class WaypointsService:
         self.hub.publish_throttled(FIX_CHANNEL, state, FIX_CHANNEL_MAX_HZ)
         if state["fix"]:
             self.geofence.note_position(state["lng"], state["lat"])
+
+    def on_heading(self, yaw_rad: float | None) -> None:
+        state = self.heading.update(yaw_rad)
+        if state is not None:
+            self.hub.publish_throttled(HEADING_CHANNEL, state, HEADING_CHANNEL_MAX_HZ)
+
+    def check_heading(self) -> None:
+        stale = self.heading.went_stale()
+        if stale is not None:
+            self.hub.publish(HEADING_CHANNEL, stale)
 
     # --- changes ---
 
@@ -99,4 +114,5 @@ class WaypointsService:
 
     def panel_context(self) -> dict:
         return {"mission": self.store.mission(), "map": self.map_config(), "fix": self.track.state(),
+                "heading": self.heading.state(),
                 "geofence": self.geofence.collection()}

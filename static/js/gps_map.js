@@ -1,6 +1,6 @@
 // The GPS map the waypoints panel and the fleet page share: MapLibre with a style of our own, so
-// nothing is fetched unless a local basemap is installed (rover_web/basemap: the app serves its
-// tiles), a graticule to read positions by without one, and the same controls everywhere.
+// nothing is fetched but from this app: raster tiles of a local store and drawn GeoJSON basemaps
+// (rover_web/basemap), a graticule to read positions by, and the same controls everywhere.
 // maplibregl is the vendored global (static/vendor/maplibre-gl-*), loaded with `defer`.
 
 export function fmtLatLng(lat, lng) {
@@ -11,6 +11,33 @@ export function fmtLatLng(lat, lng) {
 
 const EMPTY = { type: 'FeatureCollection', features: [] };
 
+// Drawn basemaps (rover_web/basemap/features.py): each feature's properties.kind picks its look.
+// Areas first, then lines, so a path along a shore stays visible; muted colours under the robot's.
+export const FEATURE_COLORS = {
+  land: '#2b3a2e', park: '#2f4a33', wetland: '#2e4a45', sand: '#5a5238', water: '#1d4f7a',
+  pier: '#6e6a60', building: '#4a4f57', road: '#8a8f98', path: '#b7a98a', shore: '#5f9fd6',
+};
+const AREA_KINDS = ['land', 'park', 'wetland', 'sand', 'water', 'pier', 'building'];
+const LINE_KINDS = ['shore', 'path', 'road'];
+const colorOf = (kinds) => ['match', ['get', 'kind'], ...kinds.flatMap((k) => [k, FEATURE_COLORS[k]]), '#888888'];
+
+function featureLayers(source) {
+  const area = ['in', ['geometry-type'], ['literal', ['Polygon', 'MultiPolygon']]];
+  const line = ['in', ['geometry-type'], ['literal', ['LineString', 'MultiLineString']]];
+  // Water above land: a lake drawn inside a land polygon must not be covered by it.
+  return [
+    { id: `${source}-land`, type: 'fill', source,
+      filter: ['all', area, ['in', ['get', 'kind'], ['literal', AREA_KINDS.filter((k) => k !== 'water')]]],
+      paint: { 'fill-color': colorOf(AREA_KINDS) } },
+    { id: `${source}-water`, type: 'fill', source, filter: ['all', area, ['==', ['get', 'kind'], 'water']],
+      paint: { 'fill-color': FEATURE_COLORS.water } },
+    { id: `${source}-lines`, type: 'line', source,
+      filter: ['all', line, ['in', ['get', 'kind'], ['literal', LINE_KINDS]]],
+      layout: { 'line-cap': 'round', 'line-join': 'round' },
+      paint: { 'line-color': colorOf(LINE_KINDS), 'line-width': ['match', ['get', 'kind'], 'road', 3, 1.5] } },
+  ];
+}
+
 // cfg: the server's map config (center, zoom, basemap or null). sources/layers: the page's own,
 // drawn above the basemap and the grid.
 function buildStyle(cfg, sources, layers) {
@@ -19,14 +46,22 @@ function buildStyle(cfg, sources, layers) {
     sources: { graticule: { type: 'geojson', data: EMPTY }, ...sources },
     layers: [{ id: 'background', type: 'background', paint: { 'background-color': '#17212b' } }],
   };
+  // Drawn basemaps under the raster tiles: where a store has tiles (imagery, a real survey) they
+  // win; beyond the store's bounds the drawn ones still show.
+  const drawn = cfg.features || [];
+  drawn.forEach((f, i) => {
+    style.sources[`features-${i}`] = { type: 'geojson', data: f.url, attribution: f.attribution };
+    style.layers.push(...featureLayers(`features-${i}`));
+  });
   if (cfg.basemap) {
     const { name, ...source } = cfg.basemap;
     style.sources.basemap = { type: 'raster', ...source };
     style.layers.push({ id: 'basemap', type: 'raster', source: 'basemap' });
   }
+  const underlay = cfg.basemap || drawn.length;
   style.layers.push(
     { id: 'graticule', type: 'line', source: 'graticule',
-      paint: { 'line-color': cfg.basemap ? '#00000033' : '#5b6b7b', 'line-width': 1 } },
+      paint: { 'line-color': underlay ? '#00000033' : '#5b6b7b', 'line-width': 1 } },
     ...layers,
   );
   return style;

@@ -9,6 +9,7 @@ import { drawScene } from './livemap/draw.js';
 import { publish, say } from './livemap/readout.js';
 import { attachInput } from './livemap/input.js';
 import { follow, mapPageUrl, sendGoal } from './livemap/network.js';
+import { POSE_HINT, POSE_MODE, finishPoseGesture } from './livemap/initial_pose.js';
 
 export { worldToPixel, pixelToWorld };
 
@@ -43,6 +44,7 @@ const S = {
   cursor: null,
   imageLoaded: false,
   lastGoal: null,
+  lastInitialPose: null,
   drawCount: 0,
 };
 const cp = params.current_pose;
@@ -107,9 +109,11 @@ function setMode(mode) {
   S.mode = mode;
   S.preview = null;
   $('livemap-goal-mode').setAttribute('aria-pressed', mode === 'goal' ? 'true' : 'false');
+  $('livemap-pose-mode').setAttribute('aria-pressed', mode === POSE_MODE ? 'true' : 'false');
   root.dataset.mode = mode;
-  canvas.style.cursor = mode === 'goal' ? 'crosshair' : 'grab';
+  canvas.style.cursor = mode === 'pan' ? 'grab' : 'crosshair';
   if (mode === 'goal') say('Click the goal, or press and drag towards the heading you want. Esc cancels.');
+  if (mode === POSE_MODE) say(POSE_HINT);
   requestDraw();
 }
 
@@ -126,6 +130,7 @@ window.liveMap = {
 attachInput(canvas, S, {
   viewport, redraw: requestDraw, setMode, stopTracking, sendGoal: goal,
   livePose: () => (S.pose && !noPose() ? S.pose : null),
+  setPose: (sx, sy, ex, ey) => finishPoseGesture(S, sx, sy, ex, ey, S.pose, requestDraw),
 });
 
 $('livemap-zoom-in').addEventListener('click', () => viewport.zoomCentre(1.25));
@@ -133,6 +138,7 @@ $('livemap-zoom-out').addEventListener('click', () => viewport.zoomCentre(0.8));
 $('livemap-fit').addEventListener('click', () => { setTracking(false); viewport.fit(); });
 $('livemap-track').addEventListener('change', (event) => setTracking(event.target.checked));
 $('livemap-goal-mode').addEventListener('click', () => setMode(S.mode === 'goal' ? 'pan' : 'goal'));
+$('livemap-pose-mode').addEventListener('click', () => setMode(S.mode === POSE_MODE ? 'pan' : POSE_MODE));
 $('livemap-select').addEventListener('change', (event) => {
   const option = event.target.selectedOptions[0];
   if (option && option.dataset.page) window.location.assign(option.dataset.page);

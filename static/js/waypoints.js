@@ -6,6 +6,7 @@ import { api } from './api.js';
 import { on } from './live.js';
 import { attachGeofence } from './geofence_map.js';
 import { createGpsMap, fmtLatLng } from './gps_map.js';
+import { ROBOT_LAYERS, ROBOT_SOURCES, createRobot } from './gps/robot.js';
 
 const el = document.getElementById('wp-map');
 if (el) init(el);
@@ -18,9 +19,7 @@ function init(container) {
   const message = $('wp-message');
   const state = { mission: { revision: -1, waypoints: [] }, markers: new Map(), dragging: new Set() };
   let map = null;
-  let loaded = false;
-  let robot = null;
-  let pendingTrack = null;
+  const robot = createRobot($('wp-fix'), $('wp-quality'));
 
   const say = (text, kind = '') => { message.textContent = text; message.dataset.kind = kind; };
 
@@ -168,52 +167,15 @@ function init(container) {
     await refresh();
   });
 
-  // --- the robot ---
-
-  function showFix(fix) {
-    const out = $('wp-fix');
-    if (!fix) return;
-    out.dataset.fix = fix.fix ? 'yes' : 'no';
-    if (fix.fix) {
-      out.dataset.lng = String(fix.lng);
-      out.dataset.lat = String(fix.lat);
-      out.textContent = fmtLatLng(fix.lat, fix.lng) + (fix.accuracy_m !== null ? ` ±${fix.accuracy_m} m` : '');
-    } else {
-      delete out.dataset.lng;
-      delete out.dataset.lat;
-      out.textContent = `no fix (${fix.reason})`;
-    }
-    if (!map) return;
-    if (fix.fix) {
-      if (!robot) {
-        const node = document.createElement('div');
-        node.className = 'wp-robot';
-        node.title = 'robot (GPS fix)';
-        robot = new maplibregl.Marker({ element: node }).setLngLat([fix.lng, fix.lat]).addTo(map);
-      }
-      robot.setLngLat([fix.lng, fix.lat]);
-      robot.getElement().dataset.fix = 'yes';
-    } else if (robot) {
-      robot.getElement().dataset.fix = 'no';  // kept where it was last known, greyed: never at 0,0
-    }
-    const track = { type: 'FeatureCollection', features: fix.track.length > 1
-      ? [{ type: 'Feature', properties: {}, geometry: { type: 'LineString', coordinates: fix.track } }] : [] };
-    if (loaded) map.getSource('track').setData(track); else pendingTrack = track;
-  }
-
   // --- the map ---
 
   try {
     map = createGpsMap(container, cfg, {
-      sources: { track: { type: 'geojson', data: { type: 'FeatureCollection', features: [] } } },
-      layers: [{ id: 'track', type: 'line', source: 'track',
-        layout: { 'line-cap': 'round', 'line-join': 'round' },
-        paint: { 'line-color': '#58a6ff', 'line-width': 3, 'line-opacity': 0.85 } }],
-      onLoad: () => {
-        loaded = true;
-        if (pendingTrack) map.getSource('track').setData(pendingTrack);
-      },
+      sources: ROBOT_SOURCES,
+      layers: ROBOT_LAYERS,
+      onLoad: () => robot.loaded(),
     });
+    robot.attach(map);
   } catch (err) {
     const note = $('wp-map-note');
     note.hidden = false;
@@ -234,7 +196,9 @@ function init(container) {
   }
 
   render(JSON.parse($('wp-mission').textContent));
-  showFix(JSON.parse($('wp-fix-state').textContent));
+  robot.showFix(JSON.parse($('wp-fix-state').textContent));
+  robot.showHeading(JSON.parse($('wp-heading-state').textContent));
   on('waypoints', (mission) => render(mission));
-  on('fix', showFix);
+  on('fix', robot.showFix);
+  on('heading', robot.showHeading);
 }

@@ -44,7 +44,8 @@ def wait_until(page, predicate, timeout=10.0, what="condition"):
 
 def test_click_adds_drag_moves_delete_removes_and_other_browsers_follow(live_server_factory, ros_peer, page,
                                                                          browser, tmp_path):
-    server = live_server_factory(ROVER_WEB_MAP_TILES=str(tmp_path / "no-basemap"))
+    server = live_server_factory(ROVER_WEB_MAP_TILES=str(tmp_path / "no-basemap"),
+                                 ROVER_WEB_MAP_GEOJSON_DIR=str(tmp_path / "no-drawn-basemap"))
     db = server.app.config["ROVER_WEB_DB_PATH"]
     peer = ros_peer("waypoint_listener")
     peer.subscribe("/waypoints", FLOAT64_MULTI_ARRAY, qos=1000)

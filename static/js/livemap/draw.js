@@ -3,7 +3,8 @@
 import { insideMap, isDrag, screenAngle, screenOfMapYaw, worldToScreen } from './geometry.js';
 
 export const COLORS = { robot: '#1f6feb', robotStale: '#6e7681', heading: '#ffffff', goal: '#f0883e',
-  plan: '#3fb950', waypoint: '#d2a8ff', preview: '#f0883e', background: '#0b0f13', keepOut: '#f85149' };
+  plan: '#3fb950', waypoint: '#d2a8ff', preview: '#f0883e', background: '#0b0f13', keepOut: '#f85149',
+  posePreview: '#56d4dd' };
 // The robot at its real size, but never smaller than a dot one can find.
 const MIN_ROBOT_PX = 5;
 
@@ -137,10 +138,11 @@ export function drawScene(ctx, scene) {
 
   if (preview) {
     const { sx, sy, ex, ey } = preview;
+    const color = preview.tool === 'pose' ? COLORS.posePreview : COLORS.preview;
     if (isDrag(sx, sy, ex, ey)) {
-      arrow(ctx, sx, sy, screenAngle(sx, sy, ex, ey), Math.hypot(ex - sx, ey - sy), COLORS.preview, 2);
+      arrow(ctx, sx, sy, screenAngle(sx, sy, ex, ey), Math.hypot(ex - sx, ey - sy), color, 2);
     }
-    ring(ctx, sx, sy, radius, COLORS.preview);
+    ring(ctx, sx, sy, radius, color);
   }
   return drawn;
 }

@@ -1,8 +1,11 @@
 // Pointer, wheel and keyboard on the canvas. One pointer pans (or, in goal mode, gives a goal),
 // two pinch, a click on a waypoint sends it; what the gestures change goes through `act`.
 import { gestureYaw, isDrag, screenToPixel, screenToWorld, worldToScreen } from './geometry.js';
+import { POSE_MODE } from './initial_pose.js';
 
 const WAYPOINT_HIT_PX = 12;
+// Modes whose press-and-drag draws an arrow and sends it (a goal, or the initial pose) instead of panning.
+const ARROW_TOOLS = new Set(['goal', POSE_MODE]);
 const KEY_PAN_PX = 60;
 
 // The waypoint nearest screen point (sx, sy), if one is within reach of a finger.
@@ -21,7 +24,7 @@ const midpoint = (a, b) => [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2];
 const spread = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1]) || 1;
 
 // S: the page's model. act: { viewport, redraw, setMode(mode), stopTracking(), livePose() (the
-// pose when it is live, else null), sendGoal(x, y, yaw, what) }.
+// pose when it is live, else null), sendGoal(x, y, yaw, what), setPose(sx, sy, ex, ey) (screen points) }.
 export function attachInput(canvas, S, act) {
   const { viewport, redraw } = act;
   const pointers = new Map();
@@ -29,7 +32,7 @@ export function attachInput(canvas, S, act) {
     const rect = canvas.getBoundingClientRect();
     return [event.clientX - rect.left, event.clientY - rect.top];
   };
-  const restCursor = () => { canvas.style.cursor = S.mode === 'goal' ? 'crosshair' : 'grab'; };
+  const restCursor = () => { canvas.style.cursor = ARROW_TOOLS.has(S.mode) ? 'crosshair' : 'grab'; };
 
   function startPinch() {
     const [a, b] = [...pointers.values()];
@@ -49,8 +52,8 @@ export function attachInput(canvas, S, act) {
     if (pointers.size === 2) { startPinch(); return; }
     if (pointers.size > 2) return;
     const [sx, sy] = local(event);
-    S.gesture = { kind: S.mode === 'goal' ? 'goal' : 'pan', sx, sy, lx: sx, ly: sy, moved: false };
-    if (S.mode === 'goal') S.preview = { sx, sy, ex: sx, ey: sy };
+    S.gesture = { kind: ARROW_TOOLS.has(S.mode) ? S.mode : 'pan', sx, sy, lx: sx, ly: sy, moved: false };
+    if (ARROW_TOOLS.has(S.mode)) S.preview = { sx, sy, ex: sx, ey: sy, tool: S.mode };
     else canvas.style.cursor = 'grabbing';
     redraw();
   });
@@ -72,8 +75,8 @@ export function attachInput(canvas, S, act) {
     if (gesture.kind === 'pan' && gesture.moved) {
       viewport.panBy(x - gesture.lx, y - gesture.ly);
       act.stopTracking();
-    } else if (gesture.kind === 'goal') {
-      S.preview = { sx: gesture.sx, sy: gesture.sy, ex: x, ey: y };
+    } else if (ARROW_TOOLS.has(gesture.kind)) {
+      S.preview = { sx: gesture.sx, sy: gesture.sy, ex: x, ey: y, tool: gesture.kind };
       redraw();
     }
     gesture.lx = x;
@@ -96,6 +99,9 @@ export function attachInput(canvas, S, act) {
     if (!cancelled && gesture.kind === 'goal') {
       sendGoalFrom(gesture.sx, gesture.sy, x, y);
       act.setMode('pan');  // like RViz's goal tool: one goal, then back to moving the map
+    } else if (!cancelled && gesture.kind === POSE_MODE) {
+      act.setPose(gesture.sx, gesture.sy, x, y);
+      act.setMode('pan');
     } else if (!cancelled && gesture.kind === 'pan' && !gesture.moved) {
       const w = waypointAt(S.geometry, S.view, S.waypoints, x, y);
       if (w) act.sendGoal(w.x, w.y, w.yaw, w.name);
@@ -120,6 +126,7 @@ export function attachInput(canvas, S, act) {
       '+': () => viewport.zoomCentre(1.25), '=': () => viewport.zoomCentre(1.25),
       '-': () => viewport.zoomCentre(0.8), '0': () => viewport.fit(),
       g: () => act.setMode(S.mode === 'goal' ? 'pan' : 'goal'), Escape: () => act.setMode('pan'),
+      p: () => act.setMode(S.mode === POSE_MODE ? 'pan' : POSE_MODE),
       ArrowLeft: () => viewport.panBy(KEY_PAN_PX, 0), ArrowRight: () => viewport.panBy(-KEY_PAN_PX, 0),
       ArrowUp: () => viewport.panBy(0, KEY_PAN_PX), ArrowDown: () => viewport.panBy(0, -KEY_PAN_PX),
     };

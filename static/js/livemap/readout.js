@@ -39,6 +39,7 @@ export function publish(root, S, drawn, stale) {
   const cmPerScreenPx = (S.geometry.res * 100) / S.view.scale;
   $('livemap-scale').textContent = `${fmt(cmPerScreenPx, cmPerScreenPx < 1 ? 2 : 1)} cm per pixel`;
   $('livemap-goal-mode').setAttribute('aria-pressed', S.mode === 'goal' ? 'true' : 'false');
+  $('livemap-pose-mode').setAttribute('aria-pressed', S.mode === 'pose' ? 'true' : 'false');
   root.dataset.mode = S.mode;
   window.liveMapState = {
     map: S.map, label: S.label, source: S.source, version: S.version, mode: S.mode, tracking: S.tracking,
@@ -46,6 +47,6 @@ export function publish(root, S, drawn, stale) {
     geometry: { ...S.geometry },
     view: { scale: S.view.scale, offsetX: S.view.ox, offsetY: S.view.oy, cmPerScreenPixel: cmPerScreenPx },
     canvas: { width: S.size.width, height: S.size.height, dpr: window.devicePixelRatio || 1 },
-    ...drawn, lastGoal: S.lastGoal, drawCount: S.drawCount,
+    ...drawn, lastGoal: S.lastGoal, lastInitialPose: S.lastInitialPose, drawCount: S.drawCount,
   };
 }

@@ -19,6 +19,7 @@ REQUESTS = [
     ("POST", "/api/estop", {"engaged": False}, "operator", "/api/estop"),
     ("POST", "/api/teleop", {"command": "stop"}, "operator", "/api/teleop"),
     ("POST", "/api/maps/{map}/goal", {"x": 0.0, "y": 0.0}, "operator", "/api/maps/<name>/goal"),
+    ("POST", "/api/maps/{map}/initial_pose", {"x": 0.0, "y": 0.0}, "operator", "/api/maps/<name>/initial_pose"),
     ("POST", "/api/panels/drone/unlock", {}, "operator", "/api/panels/<panel_id>/unlock"),
     ("POST", "/api/panels/drone/stop", {}, "operator", "/api/panels/<panel_id>/<control_id>"),
     ("POST", "/api/panels/drone/lock", {}, "operator", "/api/panels/<panel_id>/lock"),

@@ -27,7 +27,7 @@ def test_map_list_names_sizes_and_links(client):
     assert (basement["width_m"], basement["height_m"], basement["origin"]) == (40.0, 24.0, [-2.0, -1.5, 0.0])
     assert basement["urls"] == {"state": f"/api/maps/{B}", "image": f"/api/maps/{B}/image",
                                 "thumbnail": f"/api/maps/{B}/thumbnail", "page": f"/livemap/{B}",
-                                "goal": f"/api/maps/{B}/goal"}
+                                "goal": f"/api/maps/{B}/goal", "initial_pose": f"/api/maps/{B}/initial_pose"}
     for m in maps.values():
         thumb = client.get(m["urls"]["thumbnail"])
         assert thumb.status_code == 200 and thumb.mimetype == "image/png"
