@@ -53,6 +53,7 @@ class RosRuntime:
         self.executor.add_node(self.node)
         self._thread = threading.Thread(target=self._spin, name="ros-executor", daemon=True)
         self._stats: dict[str, TopicStats] = {}
+        self._shared: dict[tuple, list[Callable[[Any], None]]] = {}
         self._stop_hooks: list[Callable[[], None]] = []
         self._stop_lock = threading.Lock()
         self._stopped = False
@@ -129,13 +130,31 @@ class RosRuntime:
                                           event_callbacks=PublisherEventCallbacks(use_default_callbacks=False))
 
     def subscribe(self, msg_type: str | type, topic: str, callback: Callable[[Any], None],
-                  qos: str | int = "default", *, track: bool = True, raw: bool = False):
+                  qos: str | int = "default", *, track: bool = True, raw: bool = False, share: bool = False):
         """Subscribe with an exception-safe callback; `track` adds the topic to /api/status.
 
         `raw` hands the callback the serialized message (bytes) instead of deserializing it, for
-        code that measures bandwidth or decodes only some messages.
+        code that measures bandwidth or decodes only some messages. `share`: features that read the
+        same topic (telemetry and the GPS heading both read /odom) get one subscription between
+        them, with the same type, QoS and rawness, so each message is taken once, not once each;
+        such a subscription is never destroyed.
         """
         cls = message_class(msg_type) if isinstance(msg_type, str) else msg_type
+        if share:
+            key = (topic, type_name(cls), str(qos), raw)
+            callbacks = self._shared.get(key)
+            if callbacks is not None:
+                callbacks.append(callback)
+                return None
+            callbacks = self._shared[key] = [callback]
+
+            def callback(msg: Any, callbacks=callbacks) -> None:
+                for each in callbacks:
+                    try:
+                        each(msg)
+                    except Exception:
+                        self.callback_errors += 1
+                        log.exception("callback for %s failed", topic)
         stats = None
         if track:
             stats = self._stats.setdefault(topic, TopicStats(topic, type_name(cls)))

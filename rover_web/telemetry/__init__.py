@@ -34,7 +34,8 @@ def _init_robot(rover: Rover) -> None:
         if all(isinstance(v, str) or math.isfinite(v) for v in summary.values()):  # a NaN pose is not shown
             rover.hub.publish_throttled("odom", summary, max_hz)
 
-    rover.runtime.subscribe(msgs.ODOMETRY, rover.config["ROVER_WEB_ODOM_TOPIC"], on_odom, qos=10, raw=True)
+    rover.runtime.subscribe(msgs.ODOMETRY, rover.config["ROVER_WEB_ODOM_TOPIC"], on_odom, qos=10, raw=True,
+                            share=True)  # with the GPS heading (waypoints), when it reads /odom too
     rover.runtime.subscribe(msgs.BATTERY_STATE, rover.config["ROVER_WEB_BATTERY_TOPIC"],
                             lambda msg: rover.hub.publish_throttled("battery", msgs.battery_summary(msg),
                                                                     BATTERY_MAX_HZ), qos="sensor_data")

@@ -24,7 +24,7 @@ from rover_web.estop import EStopService
 from rover_web.geofence import GeofenceService
 
 from . import broadcaster, routes
-from .msgs import HEADING_TYPES, NAV_SAT_FIX, fix_reading, heading_yaw
+from .msgs import HEADING_TYPES, NAV_SAT_FIX, fix_reading, heading_yaw, odometry_yaw
 from .service import FIX_CHANNEL, HEADING_CHANNEL, WaypointsService
 
 
@@ -44,10 +44,16 @@ def _init_robot(rover: Rover) -> None:
                             lambda msg: service.on_fix(fix_reading(msg)), qos="sensor_data")
     heading_topic, kind = config["ROVER_WEB_GPS_HEADING_TOPIC"], config["ROVER_WEB_GPS_HEADING_TYPE"]
     if heading_topic:
-        # Often /odom, which telemetry already subscribes and counts: counted once.
-        rover.runtime.subscribe(HEADING_TYPES[kind], heading_topic,
-                                lambda msg: service.on_heading(heading_yaw(msg, kind)), qos="sensor_data",
-                                track=not rover.runtime.tracks(heading_topic))
+        if kind == "odometry":
+            # Usually /odom, which telemetry reads too: one raw subscription between them (the same
+            # QoS as telemetry's), each message taken once and read at known offsets (ros/cdr.py).
+            rover.runtime.subscribe(HEADING_TYPES[kind], heading_topic,
+                                    lambda raw: service.on_heading(odometry_yaw(raw)), qos=10, raw=True, share=True,
+                                    track=not rover.runtime.tracks(heading_topic))
+        else:
+            rover.runtime.subscribe(HEADING_TYPES[kind], heading_topic,
+                                    lambda msg: service.on_heading(heading_yaw(msg, kind)), qos="sensor_data",
+                                    track=not rover.runtime.tracks(heading_topic))
         rover.every(min(0.5, config["ROVER_WEB_GPS_HEADING_STALE_S"] / 2), service.check_heading,
                     name="gps-heading-staleness")
     service.broadcaster.start()

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from rover_web.ros import cdr
 from rover_web.ros.typesupport import message_class
 
 from .gps import FixReading
@@ -64,3 +65,12 @@ def heading_yaw(msg, kind: str) -> float | None:
     else:
         q = msg.pose.orientation
     return yaw_of_quaternion(float(q.x), float(q.y), float(q.z), float(q.w))
+
+
+def odometry_yaw(raw: bytes) -> float | None:
+    """heading_yaw of a serialized nav_msgs/Odometry, reading only its orientation (ros/cdr.py)."""
+    try:
+        f = cdr.odometry(raw)
+    except cdr.NotPlainCdr:
+        return heading_yaw(cdr.deserialize(raw, HEADING_TYPES["odometry"]), "odometry")
+    return yaw_of_quaternion(f.qx, f.qy, f.qz, f.qw)

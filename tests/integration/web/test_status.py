@@ -94,3 +94,20 @@ def test_two_apps_in_one_process_do_not_share_ros_state(app_factory, ros_peer):
     while "/app_b" not in (nodes := peer.graph()["nodes"]):  # graph discovery lags data
         assert time.monotonic() < deadline, nodes
         time.sleep(0.1)
+
+
+def test_telemetry_and_the_gps_heading_share_one_odom_subscription(live_server, ros_peer, sse_client):
+    """Both read /odom by default: one subscription takes each message once and serves both."""
+    node = live_server.rover.runtime.node
+    assert [s.topic_name for s in node.subscriptions].count("/odom") == 1
+    peer = ros_peer()
+    peer.advertise("/odom", ODOM)
+    peer.wait_match("/odom")
+    stream = sse_client(live_server.url + "/api/events?channels=odom,heading")
+    warm_up_until_received(peer, live_server.rover)
+    facing_north = odom(x=4.0)  # yaw +90 degrees (ENU): a compass bearing of 0
+    facing_north["pose"]["pose"]["orientation"] = {"z": 0.7071067811865476, "w": 0.7071067811865476}
+    peer.publish("/odom", facing_north)
+    stream.wait_for("odom", lambda d: d["x"] == 4.0 and abs(d["yaw"] - 1.5708) < 1e-3)
+    heading = stream.wait_for("heading", lambda d: abs(d["yaw_rad"] - 1.570796) < 1e-5)
+    assert heading["json"]["heading_deg"] in (0.0, 360.0) and heading["json"]["topic"] == "/odom"
