@@ -167,7 +167,7 @@ class RoverSim(Node):
     def __init__(self, *, context=None, x: float = 0.0, y: float = 0.0, yaw: float = 0.0,
                  stamped: bool = False, lat0: float = BENDERSON_LAT, lon0: float = BENDERSON_LON,
                  rate_hz: float = 50.0, goal_topic: str = "goal_pose", goal_speed_mps: float = 0.5,
-                 namespace: str = "/"):
+                 namespace: str = "/", floorplan=None, waypoints=(), scan_beams: int = 360, scan_hz: float = 10.0):
         super().__init__("sim_rover", namespace=namespace, context=context)
         self.drive = DiffDrive(x, y, yaw)
         self.follower = GoalFollower(max_linear_mps=goal_speed_mps)
@@ -192,6 +192,11 @@ class RoverSim(Node):
         self.diag_pub = self.create_publisher(DiagnosticArray, "diagnostics", 10)
         self.get_logger().set_level(LoggingSeverity.DEBUG)
         self.create_timer(1.0, self._health)
+        # What it senses, from its floorplan: scan, costmaps, footprint, markers (perception.py).
+        self.perception = None
+        if floorplan is not None:
+            from .perception import Perception
+            self.perception = Perception(self, floorplan, waypoints, scan_beams, scan_hz)
 
     def _health(self) -> None:
         statuses, lines = self.health.step()
@@ -313,6 +318,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                        help="PoseStamped goals to drive to (frame map; default goal_pose, in the robot's namespace)")
     group.add_argument("--goal-speed", type=float, default=0.5, metavar="M_PER_S",
                        help="top speed while driving to a goal")
+    group.add_argument("--no-perception", action="store_true",
+                       help="publish no scan, costmaps, footprint or markers")
+    group.add_argument("--scan-beams", type=int, default=360, help="beams of the simulated laser scan")
+    group.add_argument("--scan-hz", type=float, default=10.0, help="laser scans a second")
 
 
 def default_start(maps_file: str | None = None) -> tuple[float, float, float]:
@@ -324,10 +333,23 @@ def default_start(maps_file: str | None = None) -> tuple[float, float, float]:
     return first_waypoint_or_centre(first)
 
 
+def first_map(maps_file: str | None = None):
+    from rover_web.livemap.map_files import load_catalog, maps_file_path
+
+    path = maps_file_path(maps_file or os.environ.get("ROVER_WEB_MAPS_FILE") or "map_files/all_maps.json")
+    return next(iter(load_catalog(path).values()))
+
+
 def from_arguments(args: argparse.Namespace, context, namespace: str = "/", east_offset_m: float = 0.0) -> RoverSim:
     x, y, yaw = args.start if args.start else default_start(args.maps_file)
+    floorplan, waypoints = None, ()
+    if not args.no_perception:
+        from .sensors import Floorplan
+        definition = first_map(args.maps_file)
+        floorplan, waypoints = Floorplan.from_definition(definition), definition.waypoints
     return RoverSim(context=context, x=x + east_offset_m, y=y, yaw=yaw, stamped=args.stamped,
-                    goal_topic=args.goal_topic, goal_speed_mps=args.goal_speed, namespace=namespace)
+                    goal_topic=args.goal_topic, goal_speed_mps=args.goal_speed, namespace=namespace,
+                    floorplan=floorplan, waypoints=waypoints, scan_beams=args.scan_beams, scan_hz=args.scan_hz)
 
 
 def main(argv: list[str] | None = None) -> None:
