@@ -14,3 +14,10 @@ bp = Blueprint("overlays", __name__)
 @bp.get("/api/overlays")
 def overlays():
     return jsonify(current_feature(OverlayService).summary())
+
+
+@bp.app_context_processor
+def layers_context() -> dict:
+    """`overlay_layers()` for the map page's layer list (each layer's name, label and topics); a
+    function, so other pages pay nothing for it."""
+    return {"overlay_layers": lambda: current_feature(OverlayService).layers()}

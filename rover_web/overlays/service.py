@@ -200,6 +200,14 @@ class OverlayService:
 
     # --- what the page and the API read ---
 
+    def layers(self) -> list[dict]:
+        """The map page's layer list, in drawing order from the bottom."""
+        return [{"name": "costmap", "label": "Costmaps", "topics": self.costmap_topics},
+                {"name": "path", "label": "Recent path", "topics": []},
+                {"name": "footprint", "label": "Footprint", "topics": self.counts["footprint"].topics},
+                {"name": "markers", "label": "Markers", "topics": self.counts["markers"].topics},
+                {"name": "scan", "label": "Laser scan", "topics": self.counts["scan"].topics}]
+
     def summary(self) -> dict:
         return {"layers": {name: c.snapshot() for name, c in self.counts.items()},
                 "trail": self.poses.path(), "laser_offset": list(self.laser)}
