@@ -15,7 +15,7 @@ from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
 
 from . import msgs, routes
-from .service import CHANNELS, OverlayService
+from .service import CHANNELS, COSTMAP_CHECK_S, OverlayService
 
 MARKER_EXPIRY_S = 0.5
 
@@ -45,5 +45,5 @@ def _init_robot(rover: Rover) -> None:
     if service.footprint_topic:
         runtime.subscribe(msgs.POLYGON_STAMPED, service.footprint_topic,
                           lambda m: service.on_footprint(*msgs.polygon(m)), 1)
-    rover.every(1.0 / service.costmap_max_hz, service.encode_costmaps, name="overlays-costmap")
+    rover.every(COSTMAP_CHECK_S, service.encode_costmaps, name="overlays-costmap")
     rover.every(MARKER_EXPIRY_S, service.expire_markers, name="overlays-marker-expiry")

@@ -2,8 +2,8 @@
 
 Each message is converted once, in the subscription callback, into the small value the page
 draws, and each channel is rate-limited on the server (the page could not draw more anyway).
-Costmaps are the expensive one: a new grid is only kept, and a loop encodes the newest grid of
-each topic at most ROVER_WEB_COSTMAP_MAX_HZ times a second. Messages that cannot be drawn are
+Costmaps are the expensive one: a new grid is only kept, and a loop off the executor encodes the
+newest grid of each topic, at most ROVER_WEB_COSTMAP_MAX_HZ times a second. Messages that cannot be drawn are
 skipped and counted by reason (`GET /api/overlays`), never raised.
 """
 
@@ -26,6 +26,7 @@ from .poses import PoseHistory
 log = logging.getLogger(__name__)
 
 FOOTPRINT_MAX_HZ = 5.0
+COSTMAP_CHECK_S = 0.05  # how often the encoding loop looks for a new grid: the most it adds to a grid's age
 FOOTPRINT_MAX_POINTS = 200
 CHANNELS = ("scan", "costmap", "markers", "footprint")
 
@@ -69,6 +70,7 @@ class OverlayService:
         self._pending: dict[str, costmap.Grid] = {}  # newest grid per topic, not yet encoded
         self._encoded: dict[str, dict] = {}  # topic -> its part of the costmap channel
         self._grid_seq = 0
+        self._next_encode = 0.0  # monotonic time the next encoding may start
         self._markers = MarkerSet(max_points=config["ROVER_WEB_MARKERS_MAX_POINTS"])
         self._markers_lock = threading.Lock()
 
@@ -126,11 +128,14 @@ class OverlayService:
             self._pending[topic] = grid  # the encoding loop takes the newest
 
     def encode_costmaps(self) -> None:
-        """Encode the newest grid of each topic that changed, then publish every costmap once."""
+        """Encode the newest grid of each topic that changed, then publish every costmap once; at
+        most costmap_max_hz times a second. Runs on a loop of its own (COSTMAP_CHECK_S), off the executor."""
+        now = time.monotonic()
         with self._grids_lock:
+            if not self._pending or now < self._next_encode:
+                return
             pending, self._pending = self._pending, {}
-        if not pending:
-            return
+        self._next_encode = now + 1.0 / self.costmap_max_hz
         for topic, grid in pending.items():
             self._grid_seq += 1
             encoded = costmap.encode(grid, topic, self._grid_seq, self.costmap_max_side)
