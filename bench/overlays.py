@@ -6,7 +6,12 @@ viewer (publisher's CLOCK_MONOTONIC stamp -> the frame's arrival in the viewer's
 scan and costmap events each viewer got a second, and their sizes on the wire, once with the
 overlays and once with no scan or costmap subscribed (the baseline the overlays add to).
 
-    .venv/bin/python bench/overlays.py [--seconds 10] [--clients 10]
+    .venv/bin/python bench/overlays.py [--seconds 10] [--clients 10] [--browser]
+
+--browser also opens the LiveMap page in Chromium (Playwright, /usr/bin/chromium) during the run
+with the overlays on, and prints the page's frames a second (requestAnimationFrame callbacks),
+its draws a second, and its long tasks (over 50 ms, PerformanceObserver): what "10+ fps without
+stalling the page" means, measured.
 """
 
 from __future__ import annotations
@@ -17,8 +22,46 @@ import time
 
 from common import Server, SseFleet, machine, percentile, ros_env, start_peer, stop_process
 
+WATCH_PAGE = """async (seconds) => {
+    const longTasks = [];
+    new PerformanceObserver((list) => { for (const e of list.getEntries()) longTasks.push(e.duration); })
+        .observe({ type: 'longtask', buffered: false });
+    const draws0 = window.liveMapState.drawCount;
+    let frames = 0;
+    const start = performance.now();
+    await new Promise((done) => {
+        const tick = () => {
+            frames += 1;
+            if (performance.now() - start < seconds * 1000) requestAnimationFrame(tick); else done();
+        };
+        requestAnimationFrame(tick);
+    });
+    const elapsed = (performance.now() - start) / 1000;
+    return { fps: frames / elapsed, draws: (window.liveMapState.drawCount - draws0) / elapsed,
+             longTasks, layers: window.liveMapState.layers };
+}"""
 
-def run(clients: int, seconds: float, overlays: bool) -> dict:
+
+def watch_page(url: str, seconds: float) -> dict:
+    from urllib.parse import quote
+
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path="/usr/bin/chromium",
+                                     args=["--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader"])
+        try:
+            page = browser.new_context(viewport={"width": 1280, "height": 900}, bypass_csp=True).new_page()
+            page.goto(f"{url}/livemap/{quote('Science Hall Basement')}")
+            page.wait_for_function("window.liveMapState && window.liveMapState.layers"
+                                   " && window.liveMapState.layers.scan && window.liveMapState.layers.costmaps.length",
+                                   timeout=30000)
+            return page.evaluate(WATCH_PAGE, seconds)
+        finally:
+            browser.close()
+
+
+def run(clients: int, seconds: float, overlays: bool, browser: bool = False) -> dict:
     settings = {} if overlays else {"ROVER_WEB_SCAN_TOPIC": "", "ROVER_WEB_COSTMAP_TOPICS": ""}
     env = ros_env(**settings)
     server = Server(env)
@@ -43,7 +86,8 @@ def run(clients: int, seconds: float, overlays: bool) -> dict:
         cpu0, t0 = server.cpu_seconds(), time.monotonic()
         fleet.poll(seconds, on_event)
         cpu1, t1 = server.cpu_seconds(), time.monotonic()
-        return {"clients": clients, "overlays": overlays, "cpu_pct": 100 * (cpu1 - cpu0) / (t1 - t0),
+        page = watch_page(server.url, min(seconds, 5.0)) if browser else None
+        return {"page": page, "clients": clients, "overlays": overlays, "cpu_pct": 100 * (cpu1 - cpu0) / (t1 - t0),
                 "seconds": t1 - t0, "ages": ages, "sizes": sizes, "bytes": fleet.bytes_received,
                 "rss_mb": server.rss_mb()}
     finally:
@@ -54,6 +98,12 @@ def run(clients: int, seconds: float, overlays: bool) -> dict:
 
 
 def report(r: dict) -> None:
+    if r.get("page"):
+        p = r["page"]
+        long_tasks = p["longTasks"]
+        print(f"  page: {p['fps']:.1f} frames/s, {p['draws']:.1f} draws/s, {len(long_tasks)} long tasks"
+              f"{f' (longest {max(long_tasks):.0f} ms)' if long_tasks else ''}; layers {p['layers']['scan']}, "
+              f"{len(p['layers']['costmaps'])} costmap(s)")
     label = "overlays on " if r["overlays"] else "overlays off"
     print(f"{label}: {r['clients']} viewers, server CPU {r['cpu_pct']:.1f}% of a core, RSS {r['rss_mb']:.0f} MB, "
           f"{r['bytes'] / r['seconds'] / 1e3 / r['clients']:.1f} kB/s per viewer")
@@ -71,10 +121,12 @@ def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--seconds", type=float, default=10.0)
     parser.add_argument("--clients", type=int, default=10)
+    parser.add_argument("--browser", action="store_true", help="also measure the page in Chromium")
     args = parser.parse_args()
     print(machine())
     for overlays in (False, True):
-        report(run(args.clients, args.seconds, overlays))
+        result = run(args.clients, args.seconds, overlays, browser=args.browser and overlays)
+        report(result)
 
 
 if __name__ == "__main__":

@@ -80,10 +80,6 @@ class OverlayService:
         if all(map(math.isfinite, (stamp, x, y, yaw))):
             self.poses.add(stamp, x, y, yaw)
 
-    def robot_at(self, frame_id: str, stamp: float) -> tuple[float, float, float] | None:
-        """Where the frame of a robot-mounted sensor was in the map at `stamp`."""
-        return self.poses.at(stamp)
-
     # --- scan ---
 
     def on_scan(self, value: scan.Scan) -> None:
@@ -98,7 +94,7 @@ class OverlayService:
         if frame in self.map_frames:
             robot, laser = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)  # a scan already in the map frame (a simulator's)
         else:
-            robot, laser = self.robot_at(frame, value.stamp), self.laser
+            robot, laser = self.poses.at(value.stamp), self.laser
             if robot is None:
                 counts.skip("no_pose")
                 return

@@ -37,8 +37,9 @@ def scan_msg():
 
 def grid_msg():
     cells = []
-    for _row in range(40):
-        cells += [100] * 20 + [0] * 20    # the west half lethal, the east half free
+    for row in range(40):                 # row 0 at the origin (south)
+        # The west half lethal; the east half free in the south and inscribed (99) in the north.
+        cells += [100] * 20 + ([0] * 20 if row < 20 else [99] * 20)
     return {"header": {"frame_id": "map"},
             "info": {"width": 40, "height": 40, "resolution": 0.05,
                      "origin": {"position": {"x": 10.0, "y": 10.0}, "orientation": {"w": 1.0}}},
@@ -115,9 +116,12 @@ def test_every_overlay_is_drawn_where_its_coordinates_say_and_each_toggles(live_
     assert layers["scan"] == {"points": 1, "beams": 360}
     # Scan: the one return lies 2 m ahead of the robot at (23, 8), facing +x.
     assert pixel(page, s, 25.0, 8.0) == SCAN_RGB
-    # Costmap: the lethal west half is magenta over the floor, the free east half leaves it as it was.
-    lethal_on, free_on = pixel(page, s, 10.5, 11.0), pixel(page, s, 11.5, 11.0)
+    # Costmap: the lethal west half is magenta over the floor, the free south-east quarter leaves the
+    # floor as it was, and the north-east quarter is cyan (so the grid is not drawn upside down).
+    lethal_on, free_on = pixel(page, s, 10.5, 11.0), pixel(page, s, 11.5, 10.5)
     assert lethal_on[0] - lethal_on[1] > 80 and lethal_on[2] - lethal_on[1] > 80, lethal_on
+    inscribed = pixel(page, s, 11.5, 11.5)
+    assert inscribed[1] - inscribed[0] > 80 and inscribed[2] - inscribed[0] > 80, inscribed
     # Marker: a green sphere of 1 m at (26, 17).
     assert pixel(page, s, 26.0, 17.0) == MARKER_RGB
     # Footprint: its outline passes through (15, 8), the middle of its west side.
@@ -136,7 +140,8 @@ def test_every_overlay_is_drawn_where_its_coordinates_say_and_each_toggles(live_
     assert pixel(page, s, 25.0, 8.0) != SCAN_RGB
     toggle(page, "costmap", False)
     lethal_off = pixel(page, s, 10.5, 11.0)
-    assert lethal_off != lethal_on and pixel(page, s, 11.5, 11.0) == free_on
+    assert lethal_off != lethal_on and pixel(page, s, 11.5, 10.5) == free_on
+    assert pixel(page, s, 11.5, 11.5) != inscribed
     toggle(page, "markers", False)
     assert pixel(page, s, 26.0, 17.0) != MARKER_RGB
     toggle(page, "footprint", False)
