@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rover_web.livemap.msgs import occupancy_grid
 from rover_web.ros.convert import stamp_to_float, yaw_from_quaternion
 
 from .costmap import Grid
@@ -27,11 +28,9 @@ def scan(msg) -> Scan:
 
 
 def grid(msg) -> Grid:
-    info = msg.info
-    o = info.origin
-    cells = np.frombuffer(bytes(memoryview(msg.data)), dtype=np.int8) if len(msg.data) else np.zeros(0, np.int8)
-    return Grid(msg.header.frame_id, stamp_to_float(msg.header.stamp), int(info.width), int(info.height),
-                float(info.resolution), (o.position.x, o.position.y, _yaw(o.orientation)), cells)
+    info, cells = occupancy_grid(msg)  # LiveMap's reading of an OccupancyGrid, the same for a costmap
+    return Grid(info["frame_id"], stamp_to_float(msg.header.stamp), info["width"], info["height"],
+                info["resolution"], tuple(info["origin"]), cells)
 
 
 def markers(msg) -> list[dict]:

@@ -326,14 +326,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def default_start(maps_file: str | None = None) -> tuple[float, float, float]:
     """The first waypoint (else the centre) of the first map the GUI will show."""
-    from rover_web.livemap.map_files import first_waypoint_or_centre, load_catalog, maps_file_path
+    from rover_web.livemap.map_files import first_waypoint_or_centre
 
-    path = maps_file_path(maps_file or os.environ.get("ROVER_WEB_MAPS_FILE") or "map_files/all_maps.json")
-    first = next(iter(load_catalog(path).values()))
-    return first_waypoint_or_centre(first)
+    return first_waypoint_or_centre(first_map(maps_file))
 
 
 def first_map(maps_file: str | None = None):
+    """The first floorplan of --maps-file ($ROVER_WEB_MAPS_FILE, else map_files/all_maps.json)."""
     from rover_web.livemap.map_files import load_catalog, maps_file_path
 
     path = maps_file_path(maps_file or os.environ.get("ROVER_WEB_MAPS_FILE") or "map_files/all_maps.json")
