@@ -38,6 +38,7 @@ def _finite(*values: float) -> bool:
 @dataclass
 class MarkerSet:
     max_points: int = 5000
+    points: int = 0  # in all the markers kept, against max_points
     markers: dict[tuple[str, int], dict] = field(default_factory=dict)
     _expiry: dict[tuple[str, int], float] = field(default_factory=dict)
 
@@ -47,20 +48,22 @@ class MarkerSet:
         if marker["action"] == DELETEALL:
             self.markers.clear()
             self._expiry.clear()
+            self.points = 0
             return
         if marker["action"] == DELETE:
-            self.markers.pop(key, None)
-            self._expiry.pop(key, None)
+            self._remove(key)
             return
         if marker["action"] != ADD:
             raise BadMarker("bad_action")
         if marker["type"] not in KINDS:
             raise BadMarker("unsupported_type")
         drawn = self._project(marker, robot)
-        used = sum(len(m["points"]) for k, m in self.markers.items() if k != key)
+        replaced = self.markers.get(key)
+        used = self.points - (len(replaced["points"]) if replaced else 0)
         if used + len(drawn["points"]) > self.max_points:
             raise BadMarker("too_many_points")
         self.markers[key] = drawn
+        self.points = used + len(drawn["points"])
         if marker["lifetime_s"] > 0:
             self._expiry[key] = now + marker["lifetime_s"]
         else:
@@ -70,9 +73,14 @@ class MarkerSet:
         """Drop markers whose lifetime ran out; True if any went."""
         gone = [k for k, t in self._expiry.items() if t <= now]
         for key in gone:
-            self.markers.pop(key, None)
-            del self._expiry[key]
+            self._remove(key)
         return bool(gone)
+
+    def _remove(self, key: tuple[str, int]) -> None:
+        removed = self.markers.pop(key, None)
+        self._expiry.pop(key, None)
+        if removed:
+            self.points -= len(removed["points"])
 
     def payload(self, topic: str) -> dict:
         return {"topic": topic, "markers": list(self.markers.values())}

@@ -89,8 +89,11 @@ def test_markers_add_replace_delete_and_expire():
     with pytest.raises(BadMarker, match="no_pose"):
         markers.apply(marker(id=5, frame_id="base_link"), None, 0.0)
     assert markers.expire(1.5) and len(markers.markers) == 1
+    markers.apply(marker(id=3, type=8, points=[(0.0, 0.0)] * 4), None, 0.0)   # the expired line's points are free again
+    assert markers.points == 4
     markers.apply(marker(action=2), None, 2.0)
-    assert markers.markers == {}
+    markers.apply(marker(id=3, action=2), None, 2.0)
+    assert markers.markers == {} and markers.points == 0
 
 
 def test_markers_in_the_robot_frame_follow_its_pose():
