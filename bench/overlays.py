@@ -69,7 +69,8 @@ def run(clients: int, seconds: float, overlays: bool, browser: bool = False) -> 
     pub = None
     try:
         fleet.poll(0.5, lambda *a: None)  # the snapshots
-        pub = start_peer("overlay_publisher.py", env, "--seconds", str(seconds + 2))
+        # With the page to watch after the viewers' run, the publisher goes on for it too.
+        pub = start_peer("overlay_publisher.py", env, "--seconds", str(seconds + (25 if browser else 2)))
         fleet.poll(1.0, lambda *a: None)  # discovery and the first grid, not measured
         ages = {"scan": [], "costmap": []}
         sizes = {"scan": [], "costmap": []}
@@ -98,12 +99,6 @@ def run(clients: int, seconds: float, overlays: bool, browser: bool = False) -> 
 
 
 def report(r: dict) -> None:
-    if r.get("page"):
-        p = r["page"]
-        long_tasks = p["longTasks"]
-        print(f"  page: {p['fps']:.1f} frames/s, {p['draws']:.1f} draws/s, {len(long_tasks)} long tasks"
-              f"{f' (longest {max(long_tasks):.0f} ms)' if long_tasks else ''}; layers {p['layers']['scan']}, "
-              f"{len(p['layers']['costmaps'])} costmap(s)")
     label = "overlays on " if r["overlays"] else "overlays off"
     print(f"{label}: {r['clients']} viewers, server CPU {r['cpu_pct']:.1f}% of a core, RSS {r['rss_mb']:.0f} MB, "
           f"{r['bytes'] / r['seconds'] / 1e3 / r['clients']:.1f} kB/s per viewer")
@@ -115,6 +110,12 @@ def report(r: dict) -> None:
         print(f"  {name:8s} {per_viewer_hz:5.1f} events/s per viewer, age median {statistics.median(ages):6.1f} ms "
               f"p99 {percentile(ages, 99):6.1f} ms max {max(ages):6.1f} ms; "
               f"{'points' if name == 'scan' else 'base64 bytes'} per event {statistics.median(r['sizes'][name]):.0f}")
+    if r.get("page"):
+        p = r["page"]
+        long_tasks = p["longTasks"]
+        print(f"  page: {p['fps']:.1f} frames/s, {p['draws']:.1f} draws/s, {len(long_tasks)} long tasks"
+              f"{f' (longest {max(long_tasks):.0f} ms)' if long_tasks else ''}; layers {p['layers']['scan']}, "
+              f"{len(p['layers']['costmaps'])} costmap(s)")
 
 
 def main() -> None:
