@@ -244,7 +244,8 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("MARKERS_TOPIC", "/visualization_marker_array", "optional_topic", "MarkerArray on LiveMap; empty: off"),
     Setting("MARKERS_MAX_HZ", 5.0, "float", "most `markers` channel updates per second", 0.2, 30),
     Setting("MARKERS_MAX_POINTS", 5000, "int", "markers past this many points in all are skipped", 10, 1_000_000),
-    Setting("FOOTPRINT_TOPIC", "/global_costmap/published_footprint", "optional_topic", "footprint on LiveMap"),
+    Setting("FOOTPRINT_TOPIC", "/global_costmap/published_footprint", "optional_topic",
+            "geometry_msgs/PolygonStamped footprint drawn on LiveMap; empty: off"),
     Setting("LIVEMAP_TRAIL_S", 60.0, "float", "how far back LiveMap's recent path reaches (s)", 1, 3600),
     # --- camera ---
     Setting("CAMERA_TOPIC", "/camera/image_raw", "topic",
