@@ -99,10 +99,10 @@ class OverlayService:
                 counts.skip("no_pose")
                 return
         angles, ranges, invalid = scan.thin(value, self.scan_bins)
-        counts.drop(invalid)  # NaN, inf and out-of-range beams: no return, as RViz shows them
-        if invalid == len(value.ranges):
-            counts.skip("no_valid_ranges")
-            return
+        # NaN, inf and out-of-range beams are no return, as RViz shows them: counted, not drawn. A
+        # scan with none left is still sent, empty: the robot sees nothing in range (an open field,
+        # a laser inside a wall), and the page must not keep showing the last scan's points.
+        counts.drop(invalid)
         points = scan.to_map(angles, ranges, robot, laser)
         counts.send()
         self.hub.publish_throttled("scan", scan.payload(self.scan_topic, value, robot, points), self.scan_max_hz)

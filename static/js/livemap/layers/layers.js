@@ -77,7 +77,9 @@ export function createLayers(panel, redraw) {
       for (const [name, c] of Object.entries(summary.layers)) {
         const el = document.getElementById(`overlay-skipped-${name}`);
         if (el) el.textContent = c.skipped ? `${c.skipped} skipped` : '';
-        if (el) el.title = Object.entries(c.skipped_by_reason).map(([k, v]) => `${k}: ${v}`).join(', ');
+        const reasons = Object.entries(c.skipped_by_reason).map(([k, v]) => `${k}: ${v}`);
+        if (c.dropped_items) reasons.push(`${c.dropped_items} ${name === 'scan' ? 'beams without a return' : 'items left out'}`);
+        if (el) el.title = `${c.received} received, ${c.converted} drawn${reasons.length ? `; ${reasons.join(', ')}` : ''}`;
       }
       L.counts = summary.layers;
       redraw();
