@@ -1,10 +1,12 @@
-"""GET /api/overlays: each LiveMap overlay's topics and message counts, and the robot's recent path."""
+"""GET /api/overlays: each LiveMap overlay's topics and message counts, the robot's recent path and,
+with ?costmaps=1, every costmap's cells."""
 
 from __future__ import annotations
 
-from flask import Blueprint, jsonify
+from flask import Blueprint, jsonify, request
 
 from rover_web.core.state import current_feature
+from rover_web.web.http import ApiError
 
 from .service import OverlayService
 
@@ -13,7 +15,14 @@ bp = Blueprint("overlays", __name__)
 
 @bp.get("/api/overlays")
 def overlays():
-    return jsonify(current_feature(OverlayService).summary())
+    feature = current_feature(OverlayService)
+    summary = feature.summary()
+    raw = request.args.get("costmaps", "0")
+    if raw not in ("0", "1"):
+        raise ApiError(400, "bad_costmaps", f"costmaps must be 0 or 1, got {raw[:20]!r}")
+    if raw == "1":
+        summary["costmaps"] = feature.costmaps()
+    return jsonify(summary)
 
 
 @bp.app_context_processor

@@ -138,9 +138,18 @@ class OverlayService:
             self.counts["costmap"].send()
             with self._grids_lock:
                 self._encoded[topic] = encoded
+        # Only the grids that changed carry their cells: a global costmap that changes once a minute
+        # is not sent again with every local one. A page missing a grid's cells (one opened since)
+        # reads them from GET /api/overlays?costmaps=1.
         with self._grids_lock:
-            layers = [self._encoded[t] for t in self.costmap_topics if t in self._encoded]
+            layers = [self._encoded[t] if t in pending else {**self._encoded[t], "data": None}
+                      for t in self.costmap_topics if t in self._encoded]
         self.hub.publish("costmap", {"costmaps": layers})
+
+    def costmaps(self) -> list[dict]:
+        """Every costmap's newest encoding, cells included."""
+        with self._grids_lock:
+            return [self._encoded[t] for t in self.costmap_topics if t in self._encoded]
 
     # --- markers ---
 

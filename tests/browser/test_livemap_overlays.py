@@ -176,3 +176,29 @@ def test_skipped_messages_are_counted_on_the_page(live_server, page, sensing):
         sensing.publish("/scan", bad)
         page.wait_for_timeout(500)
     assert "empty" in page.locator("#overlay-skipped-scan").get_attribute("title")
+
+
+def test_a_page_opened_later_reads_a_costmap_the_channel_no_longer_carries(live_server, page, sensing):
+    """The channel carries only the grids that changed: once the local costmap has changed since
+    the global one, a new page's snapshot has the global one without its cells, and the page reads
+    them from the API."""
+    sensing.advertise("/local_costmap/costmap", GRID, qos="latched")
+    sensing.wait_match("/global_costmap/costmap")
+    sensing.wait_match("/local_costmap/costmap")
+    sensing.publish("/global_costmap/costmap", grid_msg())
+    local = {**grid_msg(), "info": {**grid_msg()["info"], "origin": {"position": {"x": 14.0, "y": 10.0},
+                                                                   "orientation": {"w": 1.0}}}}
+    deadline = time.monotonic() + 20
+    while True:   # until the latest `costmap` value is the local one's, the global one without its cells
+        sensing.publish("/local_costmap/costmap", local)
+        time.sleep(1.2)
+        latest = live_server.rover.hub.latest("costmap")
+        if latest and len(latest["costmaps"]) == 2 and latest["costmaps"][0]["data"] is None:
+            break
+        assert time.monotonic() < deadline, latest
+    open_map(page, live_server.url)
+    page.wait_for_function("window.liveMapState.layers.costmaps.length === 2", timeout=15000)
+    s = state(page)
+    lethal = pixel(page, s, 10.5, 11.0)    # the global grid's lethal west half, drawn from the API's cells
+    assert lethal[0] - lethal[1] > 80 and lethal[2] - lethal[1] > 80, lethal
+    assert page.watch.console_errors == []

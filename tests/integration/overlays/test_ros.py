@@ -149,6 +149,11 @@ def test_a_costmap_arrives_encoded_and_decodes_to_the_cells_sent(live_server, po
     expected[expected < 0] = 255
     assert (got == expected).all()
     assert len(layer["data"]) < 5000      # 160,000 cells, mostly free: a few kilobytes
+    # The API has every costmap's cells for a page that opens later; a bad query is a clear 400.
+    summary = requests.get(live_server.url + "/api/overlays?costmaps=1", timeout=5).json()
+    assert summary["costmaps"][0]["data"] == layer["data"]
+    bad = requests.get(live_server.url + "/api/overlays?costmaps=yes", timeout=5)
+    assert bad.status_code == 400 and bad.json()["error"] == "bad_costmaps"
 
 
 def test_markers_and_a_footprint_arrive_in_the_map_frame(live_server, posed, sse_client):

@@ -78,6 +78,17 @@ def test_costmaps_are_encoded_by_the_loop_newest_first_and_all_together(service)
     layers = service.hub.latest("costmap")["costmaps"]
     assert [c["topic"] for c in layers] == ["/global_costmap/costmap", "/local_costmap/costmap"]
     assert service.counts["costmap"].snapshot()["converted"] == 2
+    # Too soon for another encoding: the new grid waits for the loop's next turn.
+    service.on_costmap("/local_costmap/costmap", Grid("map", 0.0, 1, 1, 0.5, (0.0, 0.0, 0.0), np.array([3], np.int8)))
+    service.encode_costmaps()
+    assert service.hub.latest("costmap")["costmaps"] == layers
+    # Then only the grid that changed carries its cells; the API has them all.
+    service._next_encode = 0.0
+    service.encode_costmaps()
+    global_layer, local_layer = service.hub.latest("costmap")["costmaps"]
+    assert global_layer["data"] is None and global_layer["seq"] == layers[0]["seq"]
+    assert local_layer["data"] is not None and local_layer["seq"] > layers[1]["seq"]
+    assert [c["data"] is not None for c in service.costmaps()] == [True, True]
 
 
 def test_markers_add_replace_delete_and_expire():

@@ -46,18 +46,31 @@ export function createLayers(panel, redraw) {
   on('markers', (m) => { L.markers = m.markers; redraw(); });
   on('footprint', (f) => { L.footprint = f; redraw(); });
   // A grid is decoded only when it is new (its seq changed); the others keep their canvases.
+  function decode(layer) {
+    renderCostmap(layer).then((canvas) => {
+      const current = L.costmaps.get(layer.topic);
+      if (current && current.layer.seq >= layer.seq) return;  // a newer one was decoded first
+      L.costmaps.set(layer.topic, { layer, canvas });
+      redraw();
+    }).catch((err) => console.warn(err.message));
+  }
+  // The channel carries only the cells of the grids that changed; a grid this page has never had
+  // (it opened after that grid last changed) is read from the API, once however many events ask.
+  let fetching = null;
+  function fetchCostmaps() {
+    if (fetching) return;
+    fetching = api('GET', '/api/overlays?costmaps=1')
+      .then((summary) => { for (const layer of summary.costmaps) decode(layer); })
+      .catch(() => { /* the next event asks again */ })
+      .finally(() => { fetching = null; });
+  }
   on('costmap', (c) => {
     const topics = new Set(c.costmaps.map((layer) => layer.topic));
     for (const topic of [...L.costmaps.keys()]) if (!topics.has(topic)) L.costmaps.delete(topic);
     for (const layer of c.costmaps) {
       const known = L.costmaps.get(layer.topic);
-      if (known && known.layer.seq === layer.seq) continue;
-      renderCostmap(layer).then((canvas) => {
-        const current = L.costmaps.get(layer.topic);
-        if (current && current.layer.seq > layer.seq) return;  // a newer one was decoded first
-        L.costmaps.set(layer.topic, { layer, canvas });
-        redraw();
-      }).catch((err) => console.warn(err.message));
+      if (known && known.layer.seq >= layer.seq) continue;
+      if (layer.data === null) fetchCostmaps(); else decode(layer);
     }
   });
   on('pose', (p) => {
