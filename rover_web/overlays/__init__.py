@@ -45,5 +45,7 @@ def _init_robot(rover: Rover) -> None:
     if service.footprint_topic:
         runtime.subscribe(msgs.POLYGON_STAMPED, service.footprint_topic,
                           lambda m: service.on_footprint(*msgs.polygon(m)), 1)
-    rover.every(COSTMAP_CHECK_S, service.encode_costmaps, name="overlays-costmap")
-    rover.every(MARKER_EXPIRY_S, service.expire_markers, name="overlays-marker-expiry")
+    if service.costmap_topics:
+        rover.every(COSTMAP_CHECK_S, service.encode_costmaps, name="overlays-costmap")
+    if service.markers_topic:
+        rover.every(MARKER_EXPIRY_S, service.expire_markers, name="overlays-marker-expiry")

@@ -14,7 +14,7 @@ from rover_web.overlays.costmap import Grid
 from rover_web.overlays.markers import BadMarker, MarkerSet
 from rover_web.overlays.poses import PoseHistory
 from rover_web.overlays.scan import Scan
-from rover_web.overlays.service import OverlayService
+from rover_web.overlays.service import OverlayService, laser_offset
 
 
 @pytest.fixture
@@ -128,3 +128,10 @@ def test_the_pose_at_a_stamp_is_interpolated_and_a_stamp_before_the_history_find
     assert poses.at(9.5) == (0.0, 0.0, 0.0)                # just before the oldest
     assert poses.at(5.0) is None
     assert poses.path() == [[0.0, 0.0], [1.0, 2.0]]
+
+
+def test_the_laser_offset_setting_must_be_three_numbers():
+    assert laser_offset({"ROVER_WEB_SCAN_LASER_OFFSET": ["0.2", "-0.1", "3.14"]}) == (0.2, -0.1, 3.14)
+    for bad in (["0", "0"], ["a", "0", "0"], ["nan", "0", "0"]):
+        with pytest.raises(config.ConfigError, match="ROVER_WEB_SCAN_LASER_OFFSET"):
+            laser_offset({"ROVER_WEB_SCAN_LASER_OFFSET": bad})
