@@ -76,6 +76,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         geofence,
         livemap,
         logs,
+        overlays,
         panels,
         plot,
         recording,
@@ -118,6 +119,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         scan_the_code.init_app(app, fleet)
         panels.init_app(app, fleet)
         livemap.init_app(app, fleet)
+        overlays.init_app(app, fleet)  # what the robot senses, on LiveMap
         camera.init_app(app, fleet)
         topics.init_app(app, graph)
         logs.init_app(app, graph)

@@ -107,7 +107,7 @@ def parse(value: Any) -> list[Robot]:
 
 
 # Settings that hold ROS names: each robot gets them resolved under its namespace.
-NAME_LISTS = ("ROVER_WEB_LINK_TOPICS", "ROVER_WEB_ESTOP_CANCEL_ACTIONS")
+NAME_LISTS = ("ROVER_WEB_LINK_TOPICS", "ROVER_WEB_ESTOP_CANCEL_ACTIONS", "ROVER_WEB_COSTMAP_TOPICS")
 
 
 def settings_for(robot: Robot, settings: dict[str, Any], topic_keys: Iterable[str]) -> dict[str, Any]:

@@ -173,7 +173,8 @@ class RoverSim(Node):
                  stamped: bool = False, lat0: float = BENDERSON_LAT, lon0: float = BENDERSON_LON,
                  rate_hz: float = 50.0, goal_topic: str = "goal_pose", goal_speed_mps: float = 0.5,
                  namespace: str = "/", walls: Walls | None = None, battery_charge: float = START_CHARGE,
-                 debug_logs: bool = False):
+                 debug_logs: bool = False, floorplan=None, waypoints=(), scan_beams: int = 360,
+                 scan_hz: float = 10.0):
         super().__init__("sim_rover", namespace=namespace, context=context)
         self.drive = DiffDrive(x, y, yaw)
         self.drive.walls = walls
@@ -205,6 +206,11 @@ class RoverSim(Node):
         # A real node logs at INFO; the health checks' DEBUG lines only with --debug-logs.
         self.get_logger().set_level(LoggingSeverity.DEBUG if debug_logs else LoggingSeverity.INFO)
         self.create_timer(1.0, self._health)
+        # What it senses, from its floorplan: scan, costmaps, footprint, markers (perception.py).
+        self.perception = None
+        if floorplan is not None:
+            from .perception import Perception
+            self.perception = Perception(self, floorplan, waypoints, scan_beams, scan_hz)
 
     def _health(self) -> None:
         statuses, lines = self.health.step(self.drive.linear, self.drive.angular)
@@ -354,6 +360,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                        help="the battery's charge at start (default %(default)g)")
     group.add_argument("--debug-logs", action="store_true",
                        help="log the health checks at DEBUG every 5 s too (a real node logs at INFO)")
+    group.add_argument("--no-perception", action="store_true",
+                       help="publish no scan, costmaps, footprint or markers")
+    group.add_argument("--scan-beams", type=int, default=360, help="beams of the simulated laser scan")
+    group.add_argument("--scan-hz", type=float, default=10.0, help="laser scans a second")
 
 
 @functools.lru_cache(maxsize=4)  # once, not once per robot of --robots
@@ -382,9 +392,15 @@ def from_arguments(args: argparse.Namespace, context, namespace: str = "/", east
     x, y, yaw = args.start if args.start else default_start(args.maps_file)
     # A boat is on the water, where the floorplan is only a picture: its GPS missions cross the park.
     walls = None if args.no_walls or kind == "boat" else floorplan_walls(args.maps_file)
+    floorplan, waypoints = None, ()
+    if not args.no_perception:
+        from .sensors import Floorplan
+        definition = first_map(args.maps_file)
+        floorplan, waypoints = Floorplan.from_definition(definition), definition.waypoints
     return RoverSim(context=context, x=x + east_offset_m, y=y, yaw=yaw, stamped=args.stamped,
                     goal_topic=args.goal_topic, goal_speed_mps=args.goal_speed, namespace=namespace,
-                    walls=walls, battery_charge=min(1.0, max(0.0, args.battery / 100)), debug_logs=args.debug_logs)
+                    walls=walls, battery_charge=min(1.0, max(0.0, args.battery / 100)), debug_logs=args.debug_logs,
+                    floorplan=floorplan, waypoints=waypoints, scan_beams=args.scan_beams, scan_hz=args.scan_hz)
 
 
 def main(argv: list[str] | None = None) -> None:

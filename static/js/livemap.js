@@ -10,6 +10,7 @@ import { publish, say } from './livemap/readout.js';
 import { attachInput } from './livemap/input.js';
 import { follow, mapPageUrl, sendGoal } from './livemap/network.js';
 import { POSE_HINT, POSE_MODE, finishPoseGesture } from './livemap/initial_pose.js';
+import { createLayers } from './livemap/layers/layers.js';
 
 export { worldToPixel, pixelToWorld };
 
@@ -66,7 +67,7 @@ function draw() {
   const drawn = drawScene(ctx, {
     image: S.imageLoaded ? image : null, geometry: S.geometry, view: S.view, size: S.size,
     dpr: window.devicePixelRatio || 1, plan: S.plan, waypoints: S.waypoints, goal: S.goal, pose: S.pose,
-    poseStale: noPose(), preview: S.preview, botRadiusM: S.botRadiusM, keepOut: S.keepOut,
+    poseStale: noPose(), preview: S.preview, botRadiusM: S.botRadiusM, keepOut: S.keepOut, layers,
   });
   S.drawCount += 1;
   publish(root, S, drawn, noPose());
@@ -80,6 +81,7 @@ function requestDraw() {
 }
 
 const viewport = createViewport(S, requestDraw);
+const layers = createLayers(document.getElementById('livemap-layers'), requestDraw);
 
 function resize() {
   const rect = stage.getBoundingClientRect();

@@ -95,7 +95,7 @@ function ring(ctx, sx, sy, radius, color) {
 }
 
 // scene: { image (null until loaded), geometry, view, size, dpr, plan, waypoints, goal, pose,
-// poseStale, preview, botRadiusM, keepOut }.
+// poseStale, preview, botRadiusM, keepOut, layers (optional) }.
 export function drawScene(ctx, scene) {
   const { geometry: g, view, size } = scene;
   const toScreen = (x, y) => worldToScreen(g, view, x, y);
@@ -106,11 +106,15 @@ export function drawScene(ctx, scene) {
     ctx.imageSmoothingEnabled = view.scale < 1.5;  // crisp cells when zoomed in
     ctx.drawImage(scene.image, view.ox, view.oy, g.w * view.scale, g.h * view.scale);
   }
+  const { layers } = scene;  // what the robot senses (layers/layers.js): costmaps here, the rest over the plan
+  if (layers) layers.drawUnder(ctx, { g, view, dpr: scene.dpr });
   const { plan } = scene;
   const drawn = { waypoints: [], pose: null, goal: null, plan: null, keep_out: (scene.keepOut || []).length };
   drawKeepOut(ctx, toScreen, scene.keepOut || []);
 
   drawPlan(ctx, toScreen, plan);
+  if (layers) layers.drawOver(ctx, { toScreen, g, view });
+  drawn.layers = layers ? layers.state() : null;
   drawn.plan = plan ? { points: plan.points.length, length: plan.length, frame_id: plan.frame_id } : null;
 
   ctx.font = '12px system-ui, sans-serif';

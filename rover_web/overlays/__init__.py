@@ -1,0 +1,51 @@
+"""LiveMap overlays: what the robot senses, drawn on the map page.
+
+ROS: subscribes a sensor_msgs/LaserScan (ROVER_WEB_SCAN_TOPIC), nav_msgs/OccupancyGrid costmaps
+(ROVER_WEB_COSTMAP_TOPICS), a visualization_msgs/MarkerArray (ROVER_WEB_MARKERS_TOPIC), a
+geometry_msgs/PolygonStamped footprint (ROVER_WEB_FOOTPRINT_TOPIC) and the AMCL pose (for the pose
+a scan was taken at, and the recent path).
+SSE: `scan`, `costmap`, `markers`, `footprint`, each rate-limited. HTTP: GET /api/overlays.
+Modules: service (the per-app object), scan (thinning), costmap (encoding), markers (the set),
+poses (pose history), counts, msgs, routes.
+"""
+
+from __future__ import annotations
+
+from rover_web.core.fleet import Fleet
+from rover_web.core.state import Rover
+
+from . import msgs, routes
+from .service import CHANNELS, COSTMAP_CHECK_S, OverlayService
+
+MARKER_EXPIRY_S = 0.5
+
+
+def init_app(app, fleet: Fleet) -> None:
+    for rover in fleet:
+        _init_robot(rover)
+    app.register_blueprint(routes.bp)
+
+
+def _init_robot(rover: Rover) -> None:
+    service = OverlayService(rover)
+    rover.add_feature(service)
+    rover.hub.register(*CHANNELS)
+    runtime = rover.runtime
+    config = rover.config
+    runtime.subscribe(msgs.AMCL_POSE, config["ROVER_WEB_AMCL_POSE_TOPIC"],
+                      lambda m: service.on_pose(*msgs.amcl_pose(m)), "latched", track=False)
+    if service.scan_topic:
+        runtime.subscribe(msgs.LASER_SCAN, service.scan_topic, lambda m: service.on_scan(msgs.scan(m)), "sensor_data")
+    for topic in service.costmap_topics:
+        # Nav2 publishes its costmaps transient local: a page opened later still gets the global one.
+        runtime.subscribe(msgs.OCCUPANCY_GRID, topic, lambda m, t=topic: service.on_costmap(t, msgs.grid(m)),
+                          "latched")
+    if service.markers_topic:
+        runtime.subscribe(msgs.MARKER_ARRAY, service.markers_topic, lambda m: service.on_markers(msgs.markers(m)), 10)
+    if service.footprint_topic:
+        runtime.subscribe(msgs.POLYGON_STAMPED, service.footprint_topic,
+                          lambda m: service.on_footprint(*msgs.polygon(m)), 1)
+    if service.costmap_topics:
+        rover.every(COSTMAP_CHECK_S, service.encode_costmaps, name="overlays-costmap")
+    if service.markers_topic:
+        rover.every(MARKER_EXPIRY_S, service.expire_markers, name="overlays-marker-expiry")

@@ -1,0 +1,112 @@
+"""visualization_msgs/MarkerArray projected on the map plane and kept as RViz keeps them. Pure.
+
+A marker is added or replaced by (ns, id), removed by DELETE, and all of them by DELETEALL; one
+with a lifetime disappears when it runs out. Its points are brought into the map frame here, so
+the page only draws: markers in the map frame (the pose's) as they are, markers in the robot's own
+frames (`base_link`, `base_footprint`, the laser's) placed with the robot's latest map pose, and
+markers in any other frame skipped and counted (there is no TF). z is dropped: a 2D projection.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+ARROW, CUBE, SPHERE, CYLINDER, LINE_STRIP, LINE_LIST, CUBE_LIST, SPHERE_LIST, POINTS, TEXT = range(10)
+KINDS = {ARROW: "arrow", CUBE: "cube", SPHERE: "sphere", CYLINDER: "cylinder", LINE_STRIP: "line_strip",
+         LINE_LIST: "line_list", CUBE_LIST: "cube_list", SPHERE_LIST: "sphere_list", POINTS: "points",
+         TEXT: "text"}
+ADD, DELETE, DELETEALL = 0, 2, 3
+MAP_FRAMES = ("map", "")
+ROBOT_FRAMES = ("base_link", "base_footprint", "laser", "base_scan")
+
+
+class BadMarker(ValueError):
+    """A marker that cannot be drawn; the message is the reason counted."""
+
+
+def _compose(outer: tuple[float, float, float], x: float, y: float) -> tuple[float, float]:
+    ox, oy, oyaw = outer
+    c, s = math.cos(oyaw), math.sin(oyaw)
+    return ox + c * x - s * y, oy + s * x + c * y
+
+
+def _finite(*values: float) -> bool:
+    return all(math.isfinite(v) for v in values)
+
+
+@dataclass
+class MarkerSet:
+    max_points: int = 5000
+    points: int = 0  # in all the markers kept, against max_points
+    markers: dict[tuple[str, int], dict] = field(default_factory=dict)
+    _expiry: dict[tuple[str, int], float] = field(default_factory=dict)
+
+    def apply(self, marker: dict, robot: tuple[float, float, float] | None, now: float) -> None:
+        """Add, replace or delete one marker (a plain dict from msgs.py); BadMarker says why one is skipped."""
+        key = (marker["ns"], marker["id"])
+        if marker["action"] == DELETEALL:
+            self.markers.clear()
+            self._expiry.clear()
+            self.points = 0
+            return
+        if marker["action"] == DELETE:
+            self._remove(key)
+            return
+        if marker["action"] != ADD:
+            raise BadMarker("bad_action")
+        if marker["type"] not in KINDS:
+            raise BadMarker("unsupported_type")
+        drawn = self._project(marker, robot)
+        replaced = self.markers.get(key)
+        used = self.points - (len(replaced["points"]) if replaced else 0)
+        if used + len(drawn["points"]) > self.max_points:
+            raise BadMarker("too_many_points")
+        self.markers[key] = drawn
+        self.points = used + len(drawn["points"])
+        if marker["lifetime_s"] > 0:
+            self._expiry[key] = now + marker["lifetime_s"]
+        else:
+            self._expiry.pop(key, None)
+
+    def expire(self, now: float) -> bool:
+        """Drop markers whose lifetime ran out; True if any went."""
+        gone = [k for k, t in self._expiry.items() if t <= now]
+        for key in gone:
+            self._remove(key)
+        return bool(gone)
+
+    def _remove(self, key: tuple[str, int]) -> None:
+        removed = self.markers.pop(key, None)
+        self._expiry.pop(key, None)
+        if removed:
+            self.points -= len(removed["points"])
+
+    def payload(self, topic: str) -> dict:
+        return {"topic": topic, "markers": list(self.markers.values())}
+
+    @staticmethod
+    def _project(m: dict, robot: tuple[float, float, float] | None) -> dict:
+        frame = m["frame_id"].lstrip("/")
+        if frame in MAP_FRAMES:
+            outer = (0.0, 0.0, 0.0)
+        elif frame in ROBOT_FRAMES:
+            if robot is None:
+                raise BadMarker("no_pose")
+            outer = robot
+        else:
+            raise BadMarker("unknown_frame")
+        px, py, pyaw = m["pose"]
+        if not _finite(px, py, pyaw, *m["scale"], *m["color"]) or not all(_finite(*p) for p in m["points"]):
+            raise BadMarker("not_finite")
+        x, y = _compose(outer, px, py)
+        yaw = outer[2] + pyaw
+        points = [[round(v, 3) for v in _compose((x, y, yaw), *p)] for p in m["points"]]
+        kind = KINDS[m["type"]]
+        if kind in ("line_strip", "line_list", "points", "cube_list", "sphere_list") and not points:
+            raise BadMarker("empty")
+        return {"ns": m["ns"], "id": m["id"], "type": kind, "frame_id": m["frame_id"],
+                "pose": [round(x, 3), round(y, 3), round(yaw, 4)],
+                "scale": [round(v, 4) for v in m["scale"]], "color": [round(v, 3) for v in m["color"]],
+                "colors": [[round(v, 3) for v in c] for c in m["colors"]] if len(m["colors"]) == len(points) else [],
+                "points": points, "text": m["text"][:200]}
