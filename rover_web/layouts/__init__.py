@@ -16,7 +16,9 @@ layouts), store (SQLite), service, page (the dashboard's cards and channels from
 from __future__ import annotations
 
 from rover_web.core.fleet import Fleet
-from rover_web.core.state import Rover
+from rover_web.core.state import Rover, current_feature
+from rover_web.logs.ring import LEVELS
+from rover_web.logs.service import RosoutLog
 
 from . import routes
 from .service import LayoutService
@@ -29,6 +31,13 @@ def init_app(app, fleet: Fleet) -> None:
     for rover in fleet:
         _init_robot(rover)
     app.register_blueprint(routes.bp)
+    app.jinja_env.globals["log_card_lines"] = log_card_lines
+
+
+def log_card_lines(level: str, limit: int) -> dict:
+    """A logs card's first lines (newest first) and the number of the newest line the ring saw."""
+    lines, last_seq = current_feature(RosoutLog).ring.query_at(LEVELS.get(level, 0), limit=limit)
+    return {"lines": lines, "last_seq": last_seq}
 
 
 def _init_robot(rover: Rover) -> None:

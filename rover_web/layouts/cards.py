@@ -54,7 +54,7 @@ CARDS: dict[str, CardType] = {c.name: c for c in (
              help="the floorplan with the robot on it"),
     CardType("scan_the_code", "Scan the Code", "panels/scan_the_code.html", panel="panels/scan_the_code.html",
              size=(4, 6), min_size=(3, 3), help="the light buoy's sequence"),
-    CardType("panel", "Mission panel", "cards/panel.html", panel="panels/panels.html", size=(4, 4),
+    CardType("panel", "Mission panel", "panels/panels.html", panel="panels/panels.html", size=(4, 4),
              settings=settings({"panel": {"type": "string", "maxLength": 64, "pattern": r"^([a-z][a-z0-9_-]*)?$",
                                           "description": "a panel's id; \"\" for every panel"}}),
              help="a mission control panel's light and status"),
