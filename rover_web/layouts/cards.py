@@ -76,3 +76,9 @@ CARDS: dict[str, CardType] = {c.name: c for c in (
     CardType("link", "Link", "cards/link.html", size=(6, 3), min_size=(3, 2),
              help="round trip to the server and the age of the robot's newest message"),
 )}
+
+
+def catalogue() -> list[dict]:
+    """The card types as the editor offers them (the page embeds this as JSON)."""
+    return [{"name": c.name, "title": c.title, "help": c.help, "settings": c.settings, "once": c.once,
+             "size": list(c.size), "min_size": list(c.min_size)} for c in CARDS.values()]

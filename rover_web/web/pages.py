@@ -6,6 +6,7 @@ from flask import Blueprint, render_template
 
 from rover_web.core.state import current_rover
 from rover_web.layouts import LayoutService
+from rover_web.layouts.cards import catalogue
 from rover_web.layouts.page import place
 
 from .status import build_status
@@ -23,7 +24,8 @@ def dashboard():
     return render_template("dashboard.html", status=build_status(rover), odom=rover.hub.latest("odom"),
                            battery=rover.hub.latest("battery"), layout=layout, layout_id=layout_id,
                            layouts=service.store.list(), cards=cards, missing=missing, channels=channels,
-                           uses_uplot=any(c.type in ("plot", "link") for c in cards))
+                           uses_uplot=any(c.type in ("plot", "link") for c in cards),
+                           card_types=catalogue())
 
 
 @bp.get("/status")

@@ -1,0 +1,164 @@
+"""The layout editor in Chromium, the policy enforced: drag and resize on a desktop (1400×1000), the
+list on a phone (390×844), settings, undo, and the saved layout as the server stores and renders it."""
+
+import json
+
+import pytest
+import requests
+
+from tests.browser.test_layouts import DESKTOP, PHONE, check_always_there, check_clean, choose, open_dashboard
+
+pytestmark = pytest.mark.browser
+
+START = {"version": 1, "name": "Start", "cards": [
+    {"type": "drive", "x": 0, "y": 0, "w": 4, "h": 6}, {"type": "robot", "x": 4, "y": 0, "w": 4, "h": 3}]}
+
+
+def stored(server) -> dict:
+    mine = requests.get(server.url + "/api/me/layout", timeout=5).json()
+    return requests.get(f"{server.url}/api/layouts/{mine['id']}", timeout=5).json()
+
+
+def start_editing(browser, server, viewport):
+    made = requests.post(server.url + "/api/layouts", json=START, timeout=5)
+    assert made.status_code == 201, made.text
+    choose(server, "Start")
+    context, page = open_dashboard(browser, server, viewport)
+    page.on("dialog", lambda d: d.accept())
+    page.click("#layout-edit")
+    view = "grid" if viewport == DESKTOP else "list"
+    page.wait_for_selector(f"#layout-editor[data-view='{view}']", timeout=10000)
+    assert page.locator("#layout").is_hidden()
+    return context, page
+
+
+def drag(page, selector, dx, dy):
+    box = page.locator(selector).bounding_box()
+    x, y = box["x"] + 20, box["y"] + 12
+    page.mouse.move(x, y)
+    page.mouse.down()
+    for i in range(1, 11):
+        page.mouse.move(x + dx * i / 10, y + dy * i / 10)
+    page.mouse.up()
+
+
+def test_on_a_desktop_cards_are_dragged_resized_added_set_up_undone_and_saved(live_server, browser):
+    context, page = start_editing(browser, live_server, DESKTOP)
+    try:
+        robot = "#editor-grid .grid-stack-item:has([data-card='robot'])"
+        page.wait_for_selector(robot)
+        column = page.locator("#editor-grid").bounding_box()["width"] / 12
+        drag(page, robot, 4 * column, 0)  # four columns right: x 4 -> 8
+        page.wait_for_selector(f"{robot}[gs-x='8']", timeout=5000)
+        handle = page.locator(f"{robot} .ui-resizable-se")
+        hb = handle.bounding_box()
+        page.mouse.move(hb["x"] + hb["width"] / 2, hb["y"] + hb["height"] / 2)
+        page.mouse.down()
+        for i in range(1, 11):
+            page.mouse.move(hb["x"] + hb["width"] / 2, hb["y"] + hb["height"] / 2 + 2 * 60 * i / 10)
+        page.mouse.up()
+        page.wait_for_selector(f"{robot}[gs-h='5']", timeout=5000)
+        # A camera with a topic of its own, then a second camera the editor refuses.
+        page.select_option("#editor-add", "camera")
+        camera = "#editor-grid .grid-stack-item:has([data-card='camera'])"
+        page.wait_for_selector(camera)
+        page.click(f"{camera} button:text('Settings')")
+        page.fill("#editor-settings [data-setting='topic']", "/front/image_raw")
+        page.click("#editor-settings-apply")
+        page.wait_for_selector(f"{camera} :text('/front/image_raw')")
+        page.select_option("#editor-add", "camera")
+        assert "one is the most" in page.locator("#editor-message").inner_text()
+        # Undo takes back the last change only: the camera's topic, not the camera.
+        page.click("#editor-undo")
+        page.wait_for_selector(f"{camera}:not(:has(:text('/front/image_raw')))")
+        assert page.locator(camera).count() == 1
+        page.fill("#editor-name", "Boat crew")
+        page.locator("#editor-name").dispatch_event("change")
+        with page.expect_navigation():
+            page.click("#editor-save")
+        page.wait_for_selector("body[data-link='up']", timeout=15000)
+        saved = stored(live_server)
+        assert saved["name"] == "Boat crew"
+        cards = {c["type"]: c for c in saved["cards"]}
+        assert (cards["robot"]["x"], cards["robot"]["w"], cards["robot"]["h"]) == (8, 4, 5)
+        assert cards["camera"]["settings"] == {} and cards["camera"]["y"] >= 5
+        assert [c["type"] for c in saved["cards"]] == ["drive", "robot", "camera"]  # reading order
+        assert page.locator("#layout > [data-card]").evaluate_all("els => els.map(e => e.dataset.card)") == \
+            ["drive", "robot", "camera"]
+        assert page.locator("#layout > [data-card='robot']").get_attribute("data-x") == "8"
+        check_always_there(page, DESKTOP)
+        check_clean(page)
+    finally:
+        context.close()
+
+
+def test_a_bad_save_says_why_and_keeps_the_edits(live_server, browser):
+    context, page = start_editing(browser, live_server, DESKTOP)
+    try:
+        page.select_option("#editor-add", "echo")  # an echo card needs a topic
+        page.wait_for_selector("#editor-grid [data-card='echo']")
+        page.click("#editor-save")
+        page.wait_for_selector("#editor-message[data-failed='yes']")
+        assert "cards[2].settings.topic" in page.locator("#editor-message").inner_text()
+        assert stored(live_server)["cards"] == [{**c, "settings": {}} for c in START["cards"]]
+        assert page.locator("#editor-grid [data-card='echo']").count() == 1
+    finally:
+        context.close()
+
+
+def test_on_a_phone_the_list_editor_moves_removes_and_adds(live_server, browser):
+    context, page = start_editing(browser, live_server, PHONE)
+    try:
+        items = "#editor-list > li"
+        assert page.locator(items).evaluate_all("els => els.map(e => e.querySelector('[data-card]').dataset.card)") \
+            == ["drive", "robot"]
+        page.click(f"{items}:has([data-card='robot']) button:text('Up')")
+        page.select_option("#editor-add", "scan_the_code")
+        page.click(f"{items}:has([data-card='drive']) button:text('Remove')")
+        page.wait_for_selector(f"{items}:has([data-card='scan_the_code'])")
+        assert page.locator(items).evaluate_all("els => els.map(e => e.querySelector('[data-card]').dataset.card)") \
+            == ["robot", "scan_the_code"]
+        overflow = page.evaluate("document.documentElement.scrollWidth - document.documentElement.clientWidth")
+        assert overflow <= 0
+        with page.expect_navigation():
+            page.click("#editor-save")
+        page.wait_for_selector("body[data-link='up']", timeout=15000)
+        assert [c["type"] for c in stored(live_server)["cards"]] == ["robot", "scan_the_code"]
+        assert page.locator("#layout > [data-card]").evaluate_all("els => els.map(e => e.dataset.card)") == \
+            ["robot", "scan_the_code"]
+        check_always_there(page, PHONE)
+        check_clean(page)
+    finally:
+        context.close()
+
+
+def test_an_exported_layout_imported_in_the_editor_becomes_the_users_layout(live_server, browser, tmp_path):
+    context, page = start_editing(browser, live_server, DESKTOP)
+    try:
+        boat = choose(live_server, "Boat")
+        exported = tmp_path / "boat.json"
+        exported.write_text(json.dumps({**boat, "name": "Boat copy"}))  # an export, renamed
+        with page.expect_navigation():
+            page.set_input_files("#editor-import", str(exported))
+        page.wait_for_selector("body[data-link='up']", timeout=15000)
+        assert stored(live_server) == {**boat, "name": "Boat copy"}
+        assert page.locator("#layout > [data-card]").evaluate_all("els => els.map(e => e.dataset.card)") == \
+            [c["type"] for c in boat["cards"]]
+    finally:
+        context.close()
+
+
+def test_viewers_get_no_editor_and_the_server_refuses_them(signed_server, browser):
+    context = browser.new_context(viewport=DESKTOP)
+    try:
+        page = context.new_page()
+        page.goto(signed_server.url + "/login")
+        page.fill("input[name=username]", "viewer")
+        page.fill("input[name=password]", "correct horse battery")
+        page.click("button[type=submit]")
+        page.wait_for_selector("#layout-select")
+        assert page.locator("#layout-edit").count() == 0 and page.locator("#layout-editor").count() == 0
+        refused = page.request.post(signed_server.url + "/api/layouts", data=START)
+        assert refused.status == 403
+    finally:
+        context.close()
