@@ -2,6 +2,9 @@
 list on a phone (390×844), settings, undo, and the saved layout as the server stores and renders it."""
 
 import json
+import os
+import time
+from pathlib import Path
 
 import pytest
 import requests
@@ -10,6 +13,7 @@ from tests.browser.test_layouts import DESKTOP, PHONE, check_always_there, check
 
 pytestmark = pytest.mark.browser
 
+DOC_SHOT = Path(__file__).resolve().parents[2] / "docs" / "img" / "dashboard-boat.png"
 START = {"version": 1, "name": "Start", "cards": [
     {"type": "drive", "x": 0, "y": 0, "w": 4, "h": 6}, {"type": "robot", "x": 4, "y": 0, "w": 4, "h": 3}]}
 
@@ -160,5 +164,40 @@ def test_viewers_get_no_editor_and_the_server_refuses_them(signed_server, browse
         assert page.locator("#layout-edit").count() == 0 and page.locator("#layout-editor").count() == 0
         refused = page.request.post(signed_server.url + "/api/layouts", data=START)
         assert refused.status == 403
+    finally:
+        context.close()
+
+
+def test_a_first_time_user_builds_a_boat_dashboard(live_server, browser, sim_process, tmp_path):
+    """docs/dashboards.md's steps, as a new operator takes them; the screenshot there comes from here
+    (UPDATE_DOC_SCREENSHOTS=1 writes docs/img/dashboard-boat.png)."""
+    sim_process()
+    context, page = start_editing(browser, live_server, DESKTOP)
+    try:
+        started = time.monotonic()
+        page.click("#editor-clear")
+        page.fill("#editor-name", "My boat")
+        page.locator("#editor-name").dispatch_event("change")
+        for card in ("camera", "scan_the_code", "gps_map", "drive"):  # each fills the first free place
+            page.select_option("#editor-add", card)
+        stc = "#editor-grid .grid-stack-item:has([data-card='scan_the_code'])"
+        page.wait_for_selector(f"{stc}[gs-x='6'][gs-y='0']")  # beside the camera
+        page.wait_for_selector("#editor-grid .grid-stack-item:has([data-card='drive'])[gs-x='8'][gs-y='6']")
+        with page.expect_navigation():
+            page.click("#editor-save-new")
+        page.wait_for_selector("body[data-link='up']", timeout=15000)
+        took_s = time.monotonic() - started
+        saved = stored(live_server)
+        assert saved["name"] == "My boat"
+        assert sorted(c["type"] for c in saved["cards"]) == ["camera", "drive", "gps_map", "scan_the_code"]
+        page.wait_for_selector("#camera-image[src*='stream'], #camera-video:not([hidden])", timeout=15000)
+        page.wait_for_selector(".maplibregl-canvas", timeout=15000)
+        page.wait_for_selector("#scan-the-code .stc-box", timeout=15000)
+        page.wait_for_timeout(1500)  # a few frames and light changes
+        check_always_there(page, DESKTOP)
+        check_clean(page)
+        shot = DOC_SHOT if os.environ.get("UPDATE_DOC_SCREENSHOTS") == "1" else tmp_path / "dashboard-boat.png"
+        page.screenshot(path=str(shot), full_page=False)
+        print(f"\nbuilt the boat dashboard in {took_s:.1f} s of scripted steps; screenshot {shot}")
     finally:
         context.close()

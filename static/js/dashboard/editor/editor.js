@@ -175,6 +175,7 @@ $('editor-add').addEventListener('change', (e) => {
   render();
 });
 $('editor-name').addEventListener('change', (e) => { model.rename(e.target.value.trim()); render(); });
+$('editor-clear').addEventListener('click', () => { model.clear(); render(); });
 $('editor-undo').addEventListener('click', () => { model.undo(); render(); });
 $('editor-save').addEventListener('click', () => saved(() => (layoutId === null
   ? api('POST', '/api/layouts', model.toDoc()).then((r) => api('PUT', '/api/me/layout', { id: r.id }))

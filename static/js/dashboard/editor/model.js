@@ -35,15 +35,28 @@ export class LayoutModel {
 
   bottom() { return this.cards.reduce((most, c) => Math.max(most, c.y + c.h), 0); }
 
-  // A new card of `type` below the others, at its default size; null when the layout holds one
-  // already and the type may appear once.
+  // The first cell, in reading order, where a w×h card overlaps nothing: a new card fills the
+  // space beside the others before it goes below them.
+  firstFree(w, h) {
+    const free = (x, y) => this.cards.every((c) => x + w <= c.x || c.x + c.w <= x || y + h <= c.y || c.y + c.h <= y);
+    for (let y = 0; y <= this.bottom(); y++) {
+      for (let x = 0; x + w <= COLUMNS; x++) if (free(x, y)) return { x, y };
+    }
+    return { x: 0, y: this.bottom() };
+  }
+
+  // A new card of `type` at its default size in the first free place; null when the layout holds
+  // one already and the type may appear once.
   add(type, settings = {}) {
     const t = this.types.get(type);
     if (!t || (t.once && this.cards.some((c) => c.type === type))) return null;
-    const card = keyed({ type, x: 0, y: this.bottom(), w: Math.min(COLUMNS, t.size[0]), h: t.size[1], settings });
-    this.change((m) => m.cards.push(card));
+    const w = Math.min(COLUMNS, t.size[0]);
+    const card = keyed({ type, ...this.firstFree(w, t.size[1]), w, h: t.size[1], settings });
+    this.change((m) => { m.cards.push(card); m.cards.sort((a, b) => a.y - b.y || a.x - b.x); });
     return card;
   }
+
+  clear() { if (this.cards.length) this.change((m) => { m.cards = []; }); }
 
   remove(k) { this.change((m) => { m.cards = m.cards.filter((c) => c.k !== k); }); }
 
