@@ -50,6 +50,11 @@ class NameTaken(ValueError):
     pass
 
 
+def _storable(layout_id: int) -> bool:
+    """An id SQLite can hold: a larger one (a URL or body may carry any integer) is no layout, not a 500."""
+    return 0 < layout_id < 2**63
+
+
 class LayoutStore:
     def __init__(self, db: Database, kind: str):
         self._db = db
@@ -63,6 +68,8 @@ class LayoutStore:
                  "updated_at": r["updated_at"], "updated_by": r["updated_by"]} for r in rows]
 
     def get(self, layout_id: int) -> dict | None:
+        if not _storable(layout_id):
+            return None
         row = self._db.connection().execute("SELECT body FROM layouts WHERE id = ?", (layout_id,)).fetchone()
         return json.loads(row["body"]) if row else None
 
@@ -76,6 +83,8 @@ class LayoutStore:
             raise NameTaken(doc["name"]) from None
 
     def replace(self, layout_id: int, doc: dict, by: str) -> bool:
+        if not _storable(layout_id):
+            return False
         try:
             with self._db.transaction() as conn:
                 cur = conn.execute("UPDATE layouts SET name = ?, body = ?, updated_at = ?, updated_by = ? "
@@ -85,10 +94,14 @@ class LayoutStore:
             raise NameTaken(doc["name"]) from None
 
     def delete(self, layout_id: int) -> bool:
+        if not _storable(layout_id):
+            return False
         with self._db.transaction() as conn:  # the users who had chosen it fall back (active)
             return conn.execute("DELETE FROM layouts WHERE id = ?", (layout_id,)).rowcount == 1
 
     def choose(self, user: str, layout_id: int) -> bool:
+        if not _storable(layout_id):
+            return False
         with self._db.transaction() as conn:
             if conn.execute("SELECT 1 FROM layouts WHERE id = ?", (layout_id,)).fetchone() is None:
                 return False

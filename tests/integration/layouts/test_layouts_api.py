@@ -113,9 +113,13 @@ def test_replace_delete_and_not_found(client):
     assert client.get(f"/api/layouts/{layout_id}").get_json()["name"] == "Renamed"
     assert client.put(f"/api/layouts/{layout_id}", json={**BOAT, "name": "Boat"}).status_code == 409  # a default's
     assert client.delete(f"/api/layouts/{layout_id}").get_json() == {"deleted": layout_id}
+    huge = 10**30  # more than SQLite's integers hold
     for response in (client.get(f"/api/layouts/{layout_id}"), client.delete(f"/api/layouts/{layout_id}"),
                      client.put(f"/api/layouts/{layout_id}", json=BOAT),
-                     client.put("/api/me/layout", json={"id": layout_id})):
+                     client.put("/api/me/layout", json={"id": layout_id}),
+                     client.get(f"/api/layouts/{huge}"), client.delete(f"/api/layouts/{huge}"),
+                     client.put(f"/api/layouts/{huge}", json=BOAT), client.put("/api/me/layout", json={"id": huge}),
+                     client.put("/api/me/layout", json={"id": -1})):
         assert response.status_code == 404 and response.get_json()["error"] == "not_found"
 
 
