@@ -43,7 +43,10 @@ LAYOUT_SCHEMA = {
     "type": "object",
     "properties": {
         "version": {"const": VERSION},
-        "name": {"type": "string", "minLength": 1, "maxLength": NAME_MAX, "pattern": r"\S"},
+        # Not blank; no control characters or lone surrogates (neither prints, and SQLite and the
+        # page's UTF-8 cannot hold a surrogate).
+        "name": {"type": "string", "minLength": 1, "maxLength": NAME_MAX,
+                 "pattern": "^(?=.*\\S)[^\\u0000-\\u001f\\u007f-\\u009f\\ud800-\\udfff]+$"},
         "cards": {"type": "array", "maxItems": MAX_CARDS, "items": CARD_SCHEMA},
     },
     "required": ["version", "name", "cards"],
@@ -95,7 +98,7 @@ def _first_error(validator: Draft202012Validator, doc: Any, prefix: list) -> Non
     elif error.validator == "enum":
         message = f"{error.instance!r:.40} is not one of {', '.join(map(str, error.validator_value))}"
     elif error.validator == "pattern" and path and path[-1] == "name":
-        message = "must not be blank"
+        message = "must not be blank or hold control characters"
     elif error.validator == "pattern":
         message = f"{error.instance!r:.80} is not valid here"
     else:

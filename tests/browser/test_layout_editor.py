@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 import requests
 
+from rover_web.layouts.cards import catalogue
 from tests.browser.test_layouts import DESKTOP, PHONE, check_always_there, check_clean, choose, open_dashboard
 
 pytestmark = pytest.mark.browser
@@ -201,3 +202,36 @@ def test_a_first_time_user_builds_a_boat_dashboard(live_server, browser, sim_pro
         print(f"\nbuilt the boat dashboard in {took_s:.1f} s of scripted steps; screenshot {shot}")
     finally:
         context.close()
+
+
+MODEL = """async ([doc, types]) => {
+    const { LayoutModel } = await import('/static/js/dashboard/editor/model.js');
+    const m = new LayoutModel(doc, types);
+    const cells = () => m.cards.map((c) => [c.type, c.x, c.y, c.w, c.h]);
+    const steps = {};
+    m.add('camera'); m.add('scan_the_code'); m.add('gps_map');
+    steps.added = cells();
+    steps.second_camera = m.add('camera');
+    m.place({ [m.cards.find((c) => c.type === 'scan_the_code').k]: { x: 8, y: 20, w: 4, h: 6 } });
+    steps.placed = cells();
+    m.undo();
+    steps.undone = cells();
+    m.shift(m.cards[0].k, 1);
+    steps.shifted = cells().map((c) => c[0]);
+    steps.doc = m.toDoc();
+    return steps;
+}"""
+
+
+def test_the_editors_model_places_refuses_undoes_and_saves_what_the_server_accepts(live_server, page):
+    types = catalogue()  # what the page embeds for the editor
+    page.goto(live_server.url + "/static/js/api.js")  # same origin, no page script
+    empty = {"version": 1, "name": "Model", "cards": []}
+    steps = page.evaluate(MODEL, [empty, types])
+    assert steps["added"] == [["camera", 0, 0, 6, 6], ["scan_the_code", 6, 0, 4, 6], ["gps_map", 0, 6, 8, 7]]
+    assert steps["second_camera"] is None
+    assert steps["placed"][-1] == ["scan_the_code", 8, 20, 4, 6]  # reading order: now last
+    assert steps["undone"] == steps["added"]
+    assert steps["shifted"] == ["scan_the_code", "camera", "gps_map"]
+    saved = requests.post(live_server.url + "/api/layouts", json=steps["doc"], timeout=5)
+    assert saved.status_code == 201, saved.text

@@ -77,6 +77,8 @@ BAD = [
     ("too many cards", too_many, "cards", "too_many"),
     ("a name too long", {**BOAT, "name": "n" * (NAME_MAX + 1)}, "name", "too_long"),
     ("a blank name", {**BOAT, "name": "   "}, "name", "bad_value"),
+    ("a control character in the name", {**BOAT, "name": "tab\there"}, "name", "bad_value"),
+    ("a lone surrogate in the name", {**BOAT, "name": "boat \ud800"}, "name", "bad_value"),  # SQLite cannot hold it
     ("no name", {k: v for k, v in BOAT.items() if k != "name"}, "name", "missing_field"),
     ("another version", {**BOAT, "version": 2}, "version", "bad_version"),
     ("an unknown field", {**BOAT, "theme": "dark"}, "", "unknown_field"),
