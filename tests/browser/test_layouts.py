@@ -135,3 +135,29 @@ def test_the_page_opens_one_stream_for_its_cards_channels_and_no_video_without_a
         assert "light_sequence" in channels and "diagnostics" not in channels and "pose" not in channels
     finally:
         context.close()
+
+
+def test_plot_echo_and_logs_cards_follow_the_simulator(live_server, browser, sim_process):
+    sim_process()
+    doc = {"version": 1, "name": "Observe", "cards": [
+        {"type": "plot", "x": 0, "y": 0, "w": 6, "h": 4,
+         "settings": {"series": [{"topic": "/odom", "field": "twist.twist.angular.z"}], "window_s": 30}},
+        {"type": "echo", "x": 6, "y": 0, "w": 6, "h": 4, "settings": {"topic": "/odom"}},
+        {"type": "logs", "x": 0, "y": 4, "w": 6, "h": 4, "settings": {"level": "DEBUG", "lines": 8}},
+        {"type": "link", "x": 6, "y": 4, "w": 6, "h": 3}]}
+    assert requests.post(live_server.url + "/api/layouts", json=doc, timeout=5).status_code == 201
+    choose(live_server, "Observe")
+    context, page = open_dashboard(browser, live_server, DESKTOP)
+    try:
+        page.wait_for_selector("[data-card='plot'] .plot-card-chart:not([data-points='0']) canvas", timeout=20000)
+        page.wait_for_selector("[data-card='echo'] .echo-card-msg:has-text('twist')", timeout=20000)
+        assert page.locator("[data-card='echo'] .echo-card-type").inner_text() == "nav_msgs/msg/Odometry"
+        page.wait_for_selector("[data-card='logs'] .logs-card-lines li[data-level]", timeout=20000)
+        assert page.locator("[data-card='logs'] .logs-card-lines li").count() <= 8
+        page.wait_for_selector("#link-plot canvas", timeout=10000)
+        streams = [u for u in page.requested if u.startswith("/api/events")]
+        channels = set(streams[0].split("channels=")[1].split("&")[0].split(","))
+        assert channels == {"status", "plot", "rosout"} | ALWAYS
+        check_clean(page)
+    finally:
+        context.close()
