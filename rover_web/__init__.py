@@ -74,6 +74,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         diagnostics,
         estop,
         geofence,
+        layouts,
         livemap,
         logs,
         overlays,
@@ -126,6 +127,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         diagnostics.init_app(app, fleet)
         plot.init_app(app, graph)  # after topics: plots share its subscriptions
         ros_admin.init_app(app, graph)
+        layouts.init_app(app, fleet)  # the dashboard's cards: after every feature that has one
         recording.init_app(app, fleet)  # last of the features: it records what they publish and do
         fleet_pages.init_app(app, fleet)  # /robots, /api/robots and /robots/<name>/... for every route
         zenoh_link.init_app(fleet)  # last: its summaries read every feature; its stop engages the e-stop

@@ -21,6 +21,7 @@ NIPPLEJS_VERSION="0.10.2"
 MAPLIBRE_VERSION="5.24.1"
 UPLOT_VERSION="1.6.32"
 SWAGGER_UI_VERSION="5.35.0"
+GRIDSTACK_VERSION="14.1.0"
 
 # sha256 of the npm tarballs (npm itself also checks the registry's sha512
 # integrity when it downloads them).
@@ -28,6 +29,7 @@ NIPPLEJS_TGZ_SHA256="09f50689ef1169b2bf03c8f6263b10981cd5dc572bcbc007133e8ccdff0
 MAPLIBRE_TGZ_SHA256="b84d7fdf7fba5922fd3fff9a92733936c7a03b99165afc6c84f41c311bdbfa9d"
 UPLOT_TGZ_SHA256="4b8a8191e425658e3ea8c8c1314b0fc679c861ee3a1af2b20c7b16ba50b5133d"
 SWAGGER_UI_TGZ_SHA256="1b8e891893404ea4c3558b6a87e2a3e494e7eedba41168c2ece5800a391a6ea6"
+GRIDSTACK_TGZ_SHA256="dad337eb31dccca66781783efaefd29a65a10fc067145607c95ff39a9e94a84b"
 
 # "<path inside the package>  <name in static/vendor/...>  <sha256>"
 NIPPLEJS_FILES=(
@@ -49,6 +51,13 @@ SWAGGER_UI_FILES=(
   "swagger-ui.css        swagger-ui.css        5ed08757e53da3e026d6cbecc61fe5d43585c9560b302d534ad56692519a273d"
   "LICENSE               LICENSE               cfc7749b96f63bd31c3c42b5c471bf756814053e847c10f3eb003417bc523d30"
   "NOTICE                NOTICE                0d20d1adef18aee3f40dd258172155521ce702ac445cb5f7b7d60ed32dad2fb2"
+)
+# The dashboard editor's drag and resize (docs/dashboards.md says why gridstack): the UMD bundle with
+# its drag-and-drop, which sets window.GridStack, and its stylesheet.
+GRIDSTACK_FILES=(
+  "dist/gridstack-all.js    gridstack-all.js    e12690e8e671d752c8007993967830e6a4b8bcfb2787ac85d1100dff765460b4"
+  "dist/gridstack.min.css   gridstack.min.css   74efc82159c5e8d28cb2cebd9f912be9d728bb07fa83896a6b62f4a843207126"
+  "LICENSE                  LICENSE             28d28a6e0b5c6ebca8759b162a644c31cea28aab591060c0d95c7737d8456764"
 )
 
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -119,6 +128,7 @@ if [[ "${1:-}" == "--check" ]]; then
   verify_dir "$VENDOR_DIR/maplibre-gl-$MAPLIBRE_VERSION" "${MAPLIBRE_FILES[@]}" || rc=1
   verify_dir "$VENDOR_DIR/uplot-$UPLOT_VERSION" "${UPLOT_FILES[@]}" || rc=1
   verify_dir "$VENDOR_DIR/swagger-ui-dist-$SWAGGER_UI_VERSION" "${SWAGGER_UI_FILES[@]}" || rc=1
+  verify_dir "$VENDOR_DIR/gridstack-$GRIDSTACK_VERSION" "${GRIDSTACK_FILES[@]}" || rc=1
   [[ $rc -eq 0 ]] && echo "vendor.sh: all vendored files match their pinned sha256"
   exit "$rc"
 elif [[ $# -gt 0 ]]; then
@@ -133,4 +143,5 @@ vendor_pkg nipplejs "$NIPPLEJS_VERSION" "$NIPPLEJS_TGZ_SHA256" "${NIPPLEJS_FILES
 vendor_pkg maplibre-gl "$MAPLIBRE_VERSION" "$MAPLIBRE_TGZ_SHA256" "${MAPLIBRE_FILES[@]}"
 vendor_pkg uplot "$UPLOT_VERSION" "$UPLOT_TGZ_SHA256" "${UPLOT_FILES[@]}"
 vendor_pkg swagger-ui-dist "$SWAGGER_UI_VERSION" "$SWAGGER_UI_TGZ_SHA256" "${SWAGGER_UI_FILES[@]}"
+vendor_pkg gridstack "$GRIDSTACK_VERSION" "$GRIDSTACK_TGZ_SHA256" "${GRIDSTACK_FILES[@]}"
 echo "vendor.sh: done"

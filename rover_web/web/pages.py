@@ -5,6 +5,9 @@ from __future__ import annotations
 from flask import Blueprint, render_template
 
 from rover_web.core.state import current_rover
+from rover_web.layouts import LayoutService
+from rover_web.layouts.cards import catalogue
+from rover_web.layouts.page import place
 
 from .status import build_status
 
@@ -13,13 +16,16 @@ bp = Blueprint("pages", __name__)
 
 @bp.get("/")
 def dashboard():
+    """The cards of the user's active layout (rover_web/layouts), and only the channels they need."""
     rover = current_rover()
-    channels = ["status"]
-    for panel in rover.dashboard_panels:
-        channels += [c for c in panel.channels if c not in channels]
+    service = rover.feature(LayoutService)
+    layout_id, layout = service.active()
+    cards, channels, missing = place(rover, layout)
     return render_template("dashboard.html", status=build_status(rover), odom=rover.hub.latest("odom"),
-                           battery=rover.hub.latest("battery"),
-                           panels=rover.dashboard_panels, channels=channels)
+                           battery=rover.hub.latest("battery"), layout=layout, layout_id=layout_id,
+                           layouts=service.store.list(), cards=cards, missing=missing, channels=channels,
+                           uses_uplot=any(c.type in ("plot", "link") for c in cards),
+                           card_types=catalogue())
 
 
 @bp.get("/status")

@@ -39,7 +39,8 @@ if (card) {
   let stopWatching = null;
   let slowReports = 0;
   let imageTopics = new Set((card.dataset.imageTopics || '').split(' ').filter(Boolean));
-  let topic = localStorage.getItem(STORAGE_KEY) || select.value || card.dataset.defaultTopic;
+  // A layout's camera card that names a topic shows it first (rover_web/layouts); else this browser's last choice.
+  let topic = card.dataset.cardTopic || localStorage.getItem(STORAGE_KEY) || select.value || card.dataset.defaultTopic;
   let streaming = null;  // the URL being shown, or null
   let stopAcked = null;  // stops the acknowledged reader, while it plays
   let recheckTimer = null;

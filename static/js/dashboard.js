@@ -18,15 +18,19 @@ on('status', (s) => {
   }));
 });
 
-on('odom', (o) => {
-  text('odom-linear', o.linear.toFixed(2));
-  text('odom-angular', o.angular.toFixed(2));
-  text('odom-position', `${o.x.toFixed(2)}, ${o.y.toFixed(2)}`);
-});
+// Only the channels of the cards on the page: live.js subscribes to every channel that has a handler,
+// and a layout without the Robot card must not ask for odom and battery.
+if (document.getElementById('odom-card')) {
+  on('odom', (o) => {
+    text('odom-linear', o.linear.toFixed(2));
+    text('odom-angular', o.angular.toFixed(2));
+    text('odom-position', `${o.x.toFixed(2)}, ${o.y.toFixed(2)}`);
+  });
 
-on('battery', (b) => {
-  text('odom-battery-percent', b.percent === null ? '—' : b.percent.toFixed(0));
-  text('odom-battery-voltage', b.voltage === null ? '—' : b.voltage.toFixed(2));
-  const el = document.getElementById('odom-battery');
-  if (el) el.title = `${el.dataset.topic}: ${b.status}`;
-});
+  on('battery', (b) => {
+    text('odom-battery-percent', b.percent === null ? '—' : b.percent.toFixed(0));
+    text('odom-battery-voltage', b.voltage === null ? '—' : b.voltage.toFixed(2));
+    const el = document.getElementById('odom-battery');
+    if (el) el.title = `${el.dataset.topic}: ${b.status}`;
+  });
+}

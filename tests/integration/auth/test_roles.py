@@ -12,6 +12,8 @@ import websocket
 GEOJSON = {"type": "FeatureCollection", "features": [
     {"type": "Feature", "geometry": {"type": "Point", "coordinates": [-71.0, 42.0]}, "properties": {}}]}
 
+LAYOUT = {"version": 1, "name": "roles", "cards": [{"type": "drive", "x": 0, "y": 0, "w": 4, "h": 6}]}
+
 # (method, path, body, the least role that may, the rule it exercises). Run in this order.
 REQUESTS = [
     ("POST", "/api/estop", {"engaged": True}, "viewer", "/api/estop"),
@@ -50,6 +52,10 @@ REQUESTS = [
     ("POST", "/api/camera/whep?topic=/camera/image_raw", {}, "viewer", "/api/camera/whep"),
     ("DELETE", "/api/camera/whep/nosuchsession", None, "viewer", "/api/camera/whep/<session_id>"),
     ("POST", "/api/camera/viewers/nosuchviewer/ack", {"bytes": 0}, "viewer", "/api/camera/viewers/<viewer_id>/ack"),
+    ("POST", "/api/layouts", LAYOUT, "operator", "/api/layouts"),
+    ("PUT", "/api/layouts/{layout}", LAYOUT, "operator", "/api/layouts/<int:layout_id>"),
+    ("PUT", "/api/me/layout", {"id": 1}, "viewer", "/api/me/layout"),  # picking is not changing a layout
+    ("DELETE", "/api/layouts/{layout}", None, "operator", "/api/layouts/<int:layout_id>"),
     ("POST", "/logout", {}, "viewer", "/logout"),
 ]
 # Routes whose success needs a ROS peer: for a caller who may use them, this answer (from the view,
@@ -85,11 +91,13 @@ def test_who_may_change_what(signed_server, caller):
     url = signed_server.url
     admin = {"Authorization": f"Bearer {signed_server.tokens['admin']}"}
     first_map = requests.get(url + "/api/maps", headers=admin, timeout=5).json()["maps"][0]["name"]
-    ids = {"map": first_map, "waypoint": 999, "token": 999}
+    ids = {"map": first_map, "waypoint": 999, "token": 999, "layout": 999}
     for method, path, body, least, rule in REQUESTS:
         if "{waypoint}" in path and RANK[caller] >= RANK["operator"]:
             mission = requests.get(url + "/api/waypoints", headers=admin, timeout=5).json()
             ids["waypoint"] = mission["waypoints"][-1]["id"]
+        if "{layout}" in path and RANK[caller] >= RANK["operator"]:
+            ids["layout"] = requests.get(url + "/api/layouts", headers=admin, timeout=5).json()["layouts"][-1]["id"]
         if "{token}" in path and RANK[caller] >= RANK["admin"]:
             ids["token"] = requests.get(url + "/api/tokens", headers=admin, timeout=5).json()["tokens"][-1]["id"]
         response = requests.request(method, url + path.format(**ids), json=body, headers=headers, timeout=10,

@@ -1,0 +1,152 @@
+"""A layout document, version 1, and its validation. Pure Python (jsonschema, no Flask).
+
+    {"version": 1, "name": "Boat", "cards": [{"type": "camera", "x": 4, "y": 0, "w": 8, "h": 6,
+                                              "settings": {"topic": "/camera/image_raw"}}]}
+
+The grid is COLUMNS wide and at most ROWS tall; x and y count cells from the top left. The shape is
+checked with JSON Schema (the same schema /api/openapi.json shows), each card's settings against its
+type's own schema, then what a schema cannot say: cards inside the grid, none overlapping, and one
+of each card type that may appear once. The first problem found is reported with the field it is
+in ("cards[2].settings.topic"), and nothing is stored.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from jsonschema import Draft202012Validator
+
+from .cards import CARDS
+
+VERSION = 1
+COLUMNS = 12
+ROWS = 100
+MAX_CARDS = 24
+NAME_MAX = 60
+
+CARD_SCHEMA = {
+    "type": "object",
+    "properties": {
+        "type": {"enum": sorted(CARDS)},
+        "x": {"type": "integer", "minimum": 0, "maximum": COLUMNS - 1},
+        "y": {"type": "integer", "minimum": 0, "maximum": ROWS - 1},
+        "w": {"type": "integer", "minimum": 1, "maximum": COLUMNS},
+        "h": {"type": "integer", "minimum": 1, "maximum": ROWS},
+        "settings": {"type": "object"},
+    },
+    "required": ["type", "x", "y", "w", "h"],
+    "additionalProperties": False,
+}
+LAYOUT_SCHEMA = {
+    "$schema": "https://json-schema.org/draft/2020-12/schema",
+    "title": "rover_web dashboard layout, version 1",
+    "type": "object",
+    "properties": {
+        "version": {"const": VERSION},
+        # Not blank; no control characters or lone surrogates (neither prints, and SQLite and the
+        # page's UTF-8 cannot hold a surrogate).
+        "name": {"type": "string", "minLength": 1, "maxLength": NAME_MAX,
+                 "pattern": "^(?=.*\\S)[^\\u0000-\\u001f\\u007f-\\u009f\\ud800-\\udfff]+$"},
+        "cards": {"type": "array", "maxItems": MAX_CARDS, "items": CARD_SCHEMA},
+    },
+    "required": ["version", "name", "cards"],
+    "additionalProperties": False,
+}
+_LAYOUT = Draft202012Validator(LAYOUT_SCHEMA)
+_SETTINGS = {name: Draft202012Validator(card.settings) for name, card in CARDS.items()}
+# jsonschema's keyword -> the API's error code (web/validate.py uses the same words)
+CODES = {"required": "missing_field", "additionalProperties": "unknown_field", "type": "bad_type",
+         "maxLength": "too_long", "minLength": "too_short", "maxItems": "too_many", "minItems": "too_few",
+         "enum": "bad_value", "const": "bad_version", "pattern": "bad_value", "minimum": "out_of_range",
+         "maximum": "out_of_range"}
+
+
+class InvalidLayout(ValueError):
+    """What is wrong, where (`field`, e.g. "cards[2].w") and a short code."""
+
+    def __init__(self, field: str, message: str, code: str):
+        super().__init__(f"{field}: {message}" if field else message)
+        self.field, self.code = field, code
+
+
+def field_name(path) -> str:
+    out = ""
+    for part in path:
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out
+
+
+def _first_error(validator: Draft202012Validator, doc: Any, prefix: list) -> None:
+    errors = sorted(validator.iter_errors(doc), key=lambda e: (list(map(str, e.absolute_path)), e.validator))
+    if not errors:
+        return
+    error = errors[0]
+    path = prefix + list(error.absolute_path)
+    message = error.message
+    if error.validator == "required":
+        missing = message.split("'")[1] if message.count("'") >= 2 else ""
+        path.append(missing)
+        message = "is required"
+    elif error.validator == "additionalProperties":
+        message = f"{message}; allowed: {', '.join(sorted(error.schema.get('properties', {}))) or 'none'}"
+    elif error.validator == "const" and path == ["version"]:
+        message = f"this server reads layout version {VERSION}; got {error.instance!r:.20}"
+    elif error.validator == "maxLength":
+        message = f"is longer than {error.validator_value} characters"
+    elif error.validator == "maxItems":
+        message = f"holds more than {error.validator_value} items"
+    elif error.validator == "enum":
+        message = f"{error.instance!r:.40} is not one of {', '.join(map(str, error.validator_value))}"
+    elif error.validator == "pattern" and path and path[-1] == "name":
+        message = "must not be blank or hold control characters"
+    elif error.validator == "pattern":
+        message = f"{error.instance!r:.80} is not valid here"
+    else:
+        message = message if len(message) <= 200 else message[:200] + "…"
+    raise InvalidLayout(field_name(path), message, CODES.get(error.validator, "bad_value"))
+
+
+def validate(doc: Any) -> dict:
+    """The layout, checked and normalised (settings always present, integers as int); InvalidLayout if not."""
+    if not isinstance(doc, dict):
+        raise InvalidLayout("", "a layout is a JSON object", "bad_json")
+    _first_error(_LAYOUT, doc, [])
+    cards = []
+    taken: dict[tuple[int, int], int] = {}
+    seen_once: dict[str, int] = {}
+    for i, raw in enumerate(doc["cards"]):
+        card = CARDS[raw["type"]]
+        where = f"cards[{i}]"
+        values = {k: settings_value(v) for k, v in raw.get("settings", {}).items()}
+        _first_error(_SETTINGS[card.name], values, ["cards", i, "settings"])
+        x, y, w, h = (int(raw[k]) for k in ("x", "y", "w", "h"))
+        if x + w > COLUMNS:
+            raise InvalidLayout(f"{where}.w", f"x + w is {x + w}: the grid is {COLUMNS} columns wide", "out_of_grid")
+        if y + h > ROWS:
+            raise InvalidLayout(f"{where}.h", f"y + h is {y + h}: the grid is at most {ROWS} rows tall",
+                                "out_of_grid")
+        once_key = card.name + (f":{values.get('panel', '')}" if card.name == "panel" else "")
+        if card.once or card.name == "panel":
+            if once_key in seen_once:
+                raise InvalidLayout(f"{where}.type", f"a layout holds at most one {card.name} card"
+                                    + (" per panel" if card.name == "panel" else "")
+                                    + f" (cards[{seen_once[once_key]}] is one)", "duplicate_card")
+            seen_once[once_key] = i
+        for cx in range(x, x + w):
+            for cy in range(y, y + h):
+                if (cx, cy) in taken:
+                    raise InvalidLayout(where, f"overlaps cards[{taken[cx, cy]}] at x={cx}, y={cy}", "overlap")
+                taken[cx, cy] = i
+        cards.append({"type": card.name, "x": x, "y": y, "w": w, "h": h, "settings": values})
+    return {"version": VERSION, "name": doc["name"].strip(), "cards": cards}
+
+
+def settings_value(value: Any) -> Any:
+    """Whole floats (2.0, as JSON allows for integers) become ints, so the stored JSON is canonical."""
+    if isinstance(value, float) and value.is_integer():
+        return int(value)
+    if isinstance(value, list):
+        return [settings_value(v) for v in value]
+    if isinstance(value, dict):
+        return {k: settings_value(v) for k, v in value.items()}
+    return value
