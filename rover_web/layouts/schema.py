@@ -12,9 +12,8 @@ in ("cards[2].settings.topic"), and nothing is stored.
 
 from __future__ import annotations
 
+import functools
 from typing import Any
-
-from jsonschema import Draft202012Validator
 
 from .cards import CARDS
 
@@ -52,8 +51,17 @@ LAYOUT_SCHEMA = {
     "required": ["version", "name", "cards"],
     "additionalProperties": False,
 }
-_LAYOUT = Draft202012Validator(LAYOUT_SCHEMA)
-_SETTINGS = {name: Draft202012Validator(card.settings) for name, card in CARDS.items()}
+
+
+@functools.cache
+def _validators():
+    """Made at the first validation: jsonschema and its dependencies are ~9 MB a robot with no
+    layout edit never needs (issue 32's idle memory)."""
+    from jsonschema import Draft202012Validator
+
+    return (Draft202012Validator(LAYOUT_SCHEMA),
+            {name: Draft202012Validator(card.settings) for name, card in CARDS.items()})
+
 # jsonschema's keyword -> the API's error code (web/validate.py uses the same words)
 CODES = {"required": "missing_field", "additionalProperties": "unknown_field", "type": "bad_type",
          "maxLength": "too_long", "minLength": "too_short", "maxItems": "too_many", "minItems": "too_few",
@@ -76,7 +84,7 @@ def field_name(path) -> str:
     return out
 
 
-def _first_error(validator: Draft202012Validator, doc: Any, prefix: list) -> None:
+def _first_error(validator, doc: Any, prefix: list) -> None:
     errors = sorted(validator.iter_errors(doc), key=lambda e: (list(map(str, e.absolute_path)), e.validator))
     if not errors:
         return
@@ -110,7 +118,8 @@ def validate(doc: Any) -> dict:
     """The layout, checked and normalised (settings always present, integers as int); InvalidLayout if not."""
     if not isinstance(doc, dict):
         raise InvalidLayout("", "a layout is a JSON object", "bad_json")
-    _first_error(_LAYOUT, doc, [])
+    layout_validator, settings_validators = _validators()
+    _first_error(layout_validator, doc, [])
     cards = []
     taken: dict[tuple[int, int], int] = {}
     seen_once: dict[str, int] = {}
@@ -118,7 +127,7 @@ def validate(doc: Any) -> dict:
         card = CARDS[raw["type"]]
         where = f"cards[{i}]"
         values = {k: settings_value(v) for k, v in raw.get("settings", {}).items()}
-        _first_error(_SETTINGS[card.name], values, ["cards", i, "settings"])
+        _first_error(settings_validators[card.name], values, ["cards", i, "settings"])
         x, y, w, h = (int(raw[k]) for k in ("x", "y", "w", "h"))
         if x + w > COLUMNS:
             raise InvalidLayout(f"{where}.w", f"x + w is {x + w}: the grid is {COLUMNS} columns wide", "out_of_grid")
