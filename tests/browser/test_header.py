@@ -112,6 +112,23 @@ def test_the_crowded_bar_keeps_one_line_and_every_item_within_reach(crowded, pag
     assert page.watch.console_errors == []
 
 
+def test_the_bar_keeps_its_height_as_it_squeezes(crowded, page):
+    """Narrower windows take more steps (menu, dots, tighter buttons), never another height: a bar
+    that grew or shrank would move every card under it, the joystick under a finger among them."""
+    sign_in(page, crowded.url, "operator")
+    page.goto(crowded.url + "/robots/drone/logs")
+    seen = {}
+    for width in (1600, 1200, 1000, 800, 600, 480, 390, 360):
+        page.set_viewport_size({"width": width, "height": 900})
+        page.wait_for_timeout(100)  # the refit runs on the next frame
+        seen[width] = (page.locator("#topbar").evaluate("b => b.getBoundingClientRect().height"),
+                       int(page.locator("#topbar").get_attribute("data-steps")))
+        layout = bar_layout(page)
+        assert layout["rows"] == 1 and layout["past"] == [], (width, layout)
+    assert len({height for height, _ in seen.values()}) == 1, seen
+    assert len({steps for _, steps in seen.values()}) >= 4, seen  # the steps were taken
+
+
 def test_the_menu_works_by_keyboard_and_goes_where_its_links_say(crowded, page):
     page.set_viewport_size({"width": 390, "height": 844})
     sign_in(page, crowded.url, "operator")

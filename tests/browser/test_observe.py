@@ -167,5 +167,5 @@ def test_the_status_page_plots_the_round_trip_and_the_robots_newest_message(live
     page.wait_for_function("document.querySelector('#link-plot').dataset.ageMs !== ''", timeout=10000)
     assert page.locator("#link-plot canvas").count() == 1
     page.wait_for_function("document.querySelector('#status-topics').textContent.includes('/odom')", timeout=10000)
-    assert page.locator("nav a[aria-current='page']").inner_text() == "Status"
+    assert page.locator("nav a[aria-current='page']").text_content() == "Status"  # in the bar or its menu
     assert page.watch.console_errors == [] and page.watch.offhost == []
