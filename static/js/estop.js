@@ -68,6 +68,14 @@ function engage() {
   }
 }
 
+// Escape closes a dialog without touching its returnValue: it is cleared on every opening, or an
+// Escape after a refused release would release again.
+function openDialog(fresh) {
+  if (fresh) dialogError.hidden = true;
+  dialog.returnValue = '';
+  if (!dialog.open) dialog.showModal();
+}
+
 async function release() {
   releaseButton.disabled = true;
   try {
@@ -77,7 +85,7 @@ async function release() {
     dialogError.textContent = `Not released: ${err.message}`;
     dialogError.hidden = false;
     releaseButton.title = `release failed: ${err.message}`;
-    if (!dialog.open) dialog.showModal();
+    openDialog(false);
   } finally {
     releaseButton.disabled = false;
   }
@@ -85,11 +93,7 @@ async function release() {
 
 if (box) {
   engageButton.addEventListener('click', engage);
-  releaseButton.addEventListener('click', () => {
-    dialogError.hidden = true;
-    dialog.returnValue = '';
-    dialog.showModal();
-  });
+  releaseButton.addEventListener('click', () => openDialog(true));
   // <form method="dialog">: the button pressed is the dialog's returnValue; Escape closes with ''.
   dialog.addEventListener('close', () => { if (dialog.returnValue === 'release') release(); });
   on('estop', (state) => {

@@ -116,3 +116,33 @@ def test_a_key_held_through_a_release_does_not_drive_until_pressed_again(live_se
     page.keyboard.up("KeyW")
     peer.wait_for("/cmd_vel", is_zero, timeout=2)
     assert page.watch.console_errors == [], page.watch.console_errors
+
+
+def test_a_refused_release_says_why_and_escape_then_sends_nothing_more(signed_server, page):
+    """The operator is made a viewer while the dialog is open: the server refuses the release, the
+    dialog says so, and closing it with Escape does not try again."""
+    from tests.browser.test_auth import sign_in
+    from tests.support.auth import bearer
+
+    sign_in(page, signed_server.url, "operator")
+    requests.post(signed_server.url + "/api/estop", json={"engaged": True}, headers=bearer(signed_server, "operator"),
+                  timeout=5)
+    page.goto(signed_server.url + "/logs")
+    releases = []
+    page.on("request", lambda r: r.method == "POST" and r.url.endswith("/api/estop") and releases.append(r.url))
+    page.locator("#estop-release").click()
+    page.wait_for_selector("#estop-release-dialog[open]", timeout=5000)
+    demoted = requests.patch(signed_server.url + "/api/users/operator", json={"role": "viewer"},
+                             headers=bearer(signed_server, "admin"), timeout=5)
+    assert demoted.status_code == 200, demoted.text
+    page.locator("#estop-release-confirm").click()
+    page.wait_for_selector("#estop-release-error", state="visible", timeout=5000)
+    assert page.locator("#estop-release-error").inner_text().startswith("Not released:")
+    assert page.locator("#estop-release-dialog[open]").count() == 1
+    page.keyboard.press("Escape")
+    page.wait_for_selector("#estop-release-dialog", state="hidden", timeout=5000)
+    page.wait_for_timeout(500)
+    assert len(releases) == 1
+    assert requests.get(signed_server.url + "/api/estop", headers=bearer(signed_server, "admin"),
+                        timeout=5).json()["engaged"] is True
+    assert page.locator("#estop-banner").is_visible()
