@@ -31,8 +31,12 @@ function setup() {
     ...(robot ? [{ kind: 'robot' }] : []),
   ];
 
-  function apply(k) {
-    const taken = steps.slice(0, k);
+  // linksBack: how many of the links taken out come back into the bar (the first pages, which
+  // went last), once the steps after them made room.
+  function apply(k, linksBack = 0) {
+    const linkSteps = steps.slice(0, k).filter((s) => s.kind === 'link');
+    const back = new Set(linkSteps.slice(linkSteps.length - linksBack));
+    const taken = steps.slice(0, k).filter((s) => !back.has(s));
     const moved = new Set(taken.filter((s) => s.kind === 'link').map((s) => s.index));
     links.forEach((a, i) => (moved.has(i) ? menuNav : nav).append(a));
     nav.hidden = moved.size === links.length;
@@ -65,7 +69,20 @@ function setup() {
       apply(k);
       if (fits()) break;
     }
-    bar.dataset.steps = String(Math.min(k, steps.length));
+    k = Math.min(k, steps.length);
+    // The steps after the links (dots, tighter buttons) may have made room for some of them again.
+    const linksOut = steps.slice(0, k).filter((s) => s.kind === 'link').length;
+    let back = 0;
+    if (steps[k - 1] && steps[k - 1].kind !== 'link') {
+      while (back < linksOut) {
+        apply(k, back + 1);
+        if (!fits()) break;
+        back += 1;
+      }
+      apply(k, back);
+    }
+    bar.dataset.steps = String(k);
+    bar.dataset.linksOut = String(linksOut - back);
     document.documentElement.style.setProperty('--topbar-h', `${bar.getBoundingClientRect().height}px`);
     fitting = false;
   }
