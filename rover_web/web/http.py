@@ -5,8 +5,8 @@ from __future__ import annotations
 import sqlite3
 from urllib.parse import urlsplit
 
-from flask import Flask, Request, current_app, jsonify, request
-from werkzeug.exceptions import HTTPException
+from flask import Flask, Request, current_app, jsonify, render_template, request
+from werkzeug.exceptions import HTTPException, NotFound
 from werkzeug.middleware.proxy_fix import ProxyFix
 
 from .validate import InvalidInput, loads_strict
@@ -191,6 +191,22 @@ def trust_proxies(app: Flask) -> None:
         app.wsgi_app = ProxyFix(app.wsgi_app, x_for=hops, x_proto=hops, x_host=hops)
 
 
+def _not_found_page(exc: HTTPException):
+    """A browser's 404 as a page of the app (its bar, its e-stop, where to go), not Werkzeug's bare one.
+
+    None when the page cannot be drawn (an app with no robot pages, such as the hub): the bare 404
+    then, never a 500 for an address that does not exist.
+    """
+    why = exc.description
+    if not why or why == NotFound.description:
+        why = f"There is no page at {request.path[:200]}."
+    try:
+        return render_template("not_found.html", why=why), 404
+    except Exception:  # noqa: BLE001 - whatever broke drawing it, the answer stays a 404
+        current_app.logger.warning("the not-found page could not be drawn for %s", request.path, exc_info=True)
+        return None
+
+
 def init_app(app: Flask) -> None:
     trust_proxies(app)
     app.before_request(_guard)
@@ -206,7 +222,7 @@ def init_app(app: Flask) -> None:
     @app.errorhandler(HTTPException)
     def _http_error(exc: HTTPException):
         if not wants_json(request):
-            return exc
+            return (_not_found_page(exc) if exc.code == 404 else None) or exc
         code = (exc.name or "error").lower().replace(" ", "_")
         message = exc.description or exc.name
         if exc.code == 413:

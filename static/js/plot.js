@@ -93,6 +93,7 @@ function scheduleDraw() {
 }
 
 function renderList() {
+  $('plot-empty').hidden = series.size > 0;  // what to do, until something is plotted
   $('plot-series').replaceChildren(...[...series.keys()].map((id) => {
     const li = document.createElement('li');
     li.dataset.series = id;

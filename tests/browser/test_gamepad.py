@@ -13,6 +13,7 @@ import pytest
 
 from rover_web.teleop.service import TeleopService
 from tests.browser.test_auth import sign_in
+from tests.browser.test_estop import release_estop
 from tests.support.teleop_support import is_zero, subscribe_cmd_vel, twists, warm_up
 
 pytestmark = pytest.mark.browser
@@ -226,7 +227,7 @@ def test_estop_stops_the_gamepad_and_a_held_stick_must_come_back_to_rearm(rig, p
     page.wait_for_selector("#teleop-card[data-mode='estop']", timeout=5000)
 
     # Released with enable and the stick still held: nothing moves until the stick comes back.
-    page.locator("#estop-release").click()
+    release_estop(page)
     page.wait_for_selector("#estop[data-engaged='no']", timeout=5000)
     page.wait_for_function("document.getElementById('teleop-message').textContent.includes('to re-arm')",
                            timeout=5000)

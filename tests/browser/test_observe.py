@@ -69,9 +69,11 @@ def test_the_plot_page_draws_a_simulator_series_and_exports_csv(live_server, sim
     page.wait_for_selector("#plot-topic option[value='/odom']", state="attached", timeout=15000)
     page.select_option("#plot-topic", "/odom")
     page.wait_for_selector("#plot-fields option[value='twist.twist.linear.x']", state="attached", timeout=10000)
+    assert "Nothing plotted yet" in page.locator("#plot-empty").inner_text()  # what to do first
     page.fill("#plot-field", "pose.pose.position.x")
     page.click("#plot-add")
     page.wait_for_selector("#plot-series li[data-series='/odom pose.pose.position.x']", timeout=10000)
+    assert page.locator("#plot-empty").is_hidden()
     page.wait_for_function("Number(document.querySelector('#plot-chart').dataset.points) > 20", timeout=15000)
     assert page.locator("#plot-chart canvas").count() == 1
     # A second series on the same time axis.
@@ -165,5 +167,5 @@ def test_the_status_page_plots_the_round_trip_and_the_robots_newest_message(live
     page.wait_for_function("document.querySelector('#link-plot').dataset.ageMs !== ''", timeout=10000)
     assert page.locator("#link-plot canvas").count() == 1
     page.wait_for_function("document.querySelector('#status-topics').textContent.includes('/odom')", timeout=10000)
-    assert page.locator("nav a[aria-current='page']").inner_text() == "Status"
+    assert page.locator("nav a[aria-current='page']").text_content() == "Status"  # in the bar or its menu
     assert page.watch.console_errors == [] and page.watch.offhost == []

@@ -11,6 +11,7 @@ import time
 import pytest
 
 from rover_web.linkemu import LinkEmulator, profile
+from tests.browser.test_estop import release_estop
 from tests.support.teleop_support import is_zero, subscribe_cmd_vel, twists, warm_up
 
 pytestmark = pytest.mark.browser
@@ -189,7 +190,7 @@ def test_estop_button_latches_across_reload_and_releases(rig, page):
     page.mouse.up()
     assert all(lin == 0.0 for t, lin, _ in twists(peer) if t >= zero["t"])
 
-    page.locator("#estop-release").click()
+    release_estop(page)
     page.wait_for_selector("#estop[data-engaged='no']")
     assert page.locator("#estop-release").is_hidden()
     press_stick(page)
@@ -218,7 +219,7 @@ def test_estop_is_on_every_page_and_follows_other_browsers(app_factory, page):
         page.wait_for_selector("#estop[data-engaged='yes']", timeout=5000)  # live, over SSE
         page.reload()
         assert page.locator("#estop").get_attribute("data-engaged") == "yes"  # rendered latched
-        page.locator("#estop-release").click()
+        release_estop(page)
         page.wait_for_selector("#estop[data-engaged='no']", timeout=5000)
         assert requests.get(server.url + "/api/estop", timeout=5).json()["engaged"] is False
         page.locator("#estop-engage").click()

@@ -12,7 +12,7 @@
 // "stale" whenever data-link is not `up`. The e-stop and the link bar are not greyed (the e-stop
 // must look as usable as it is): they say the connection is lost instead.
 
-const EXEMPT = '#estop, .link-health';
+const EXEMPT = '#estop, #estop-banner, .link-health';
 const observer = new MutationObserver(() => {});
 const WATCH = { subtree: true, childList: true, characterData: true, attributes: true };
 

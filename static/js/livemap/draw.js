@@ -42,16 +42,26 @@ function drawPlan(ctx, toScreen, plan) {
   ctx.stroke();
 }
 
-function drawWaypoint(ctx, w, sx, sy) {
+// The name goes right of the marker, or left of it when it would run off the canvas (a phone's
+// narrow map cut the names near its right edge), and is kept inside top and bottom. Returns the
+// label's box in screen pixels.
+function drawWaypoint(ctx, w, sx, sy, size) {
   ctx.fillStyle = COLORS.waypoint;
   ctx.beginPath();
   ctx.moveTo(sx, sy - 6); ctx.lineTo(sx + 6, sy); ctx.lineTo(sx, sy + 6); ctx.lineTo(sx - 6, sy);
   ctx.closePath();
   ctx.fill();
+  const width = ctx.measureText(w.name).width;
+  const half = 8;
+  let left = sx + 8;
+  if (left + width + 1 > size.width) left = sx - 8 - width;
+  left = Math.max(0, Math.min(left, size.width - width - 1));
+  const y = Math.max(half, Math.min(sy, size.height - half - 1));
   ctx.fillStyle = COLORS.background;  // a shadow, so the name reads on any floor colour
-  ctx.fillText(w.name, sx + 9, sy + 1);
+  ctx.fillText(w.name, left + 1, y + 1);
   ctx.fillStyle = COLORS.waypoint;
-  ctx.fillText(w.name, sx + 8, sy);
+  ctx.fillText(w.name, left, y);
+  return { left, right: left + width + 1, top: y - half, bottom: y + half + 1 };
 }
 
 function drawRobot(ctx, sx, sy, angle, radius, stale) {
@@ -121,8 +131,8 @@ export function drawScene(ctx, scene) {
   ctx.textBaseline = 'middle';
   for (const w of scene.waypoints) {
     const [sx, sy] = toScreen(w.x, w.y);
-    drawWaypoint(ctx, w, sx, sy);
-    drawn.waypoints.push({ name: w.name, screen: { x: sx, y: sy } });
+    const label = drawWaypoint(ctx, w, sx, sy, size);
+    drawn.waypoints.push({ name: w.name, screen: { x: sx, y: sy }, label });
   }
 
   const radius = robotRadiusPx(scene.botRadiusM, g, view);
