@@ -45,6 +45,11 @@ def _init_robot(rover: Rover) -> None:
     if service.footprint_topic:
         runtime.subscribe(msgs.POLYGON_STAMPED, service.footprint_topic,
                           lambda m: service.on_footprint(*msgs.polygon(m)), 1)
+    if service.costmap_topics or service.footprint_topic:
+        # Nav2's local costmap and footprint are in `odom`: placed with AMCL's map -> odom (frames.py),
+        # from the /odom subscription telemetry already has (one, shared, raw).
+        runtime.subscribe(msgs.ODOMETRY, config["ROVER_WEB_ODOM_TOPIC"], service.on_odom, qos=10, raw=True,
+                          share=True, track=not runtime.tracks(config["ROVER_WEB_ODOM_TOPIC"]))
     if service.costmap_topics:
         rover.every(COSTMAP_CHECK_S, service.encode_costmaps, name="overlays-costmap")
     if service.markers_topic:

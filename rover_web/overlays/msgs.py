@@ -15,6 +15,7 @@ OCCUPANCY_GRID = "nav_msgs/msg/OccupancyGrid"
 MARKER_ARRAY = "visualization_msgs/msg/MarkerArray"
 POLYGON_STAMPED = "geometry_msgs/msg/PolygonStamped"
 AMCL_POSE = "geometry_msgs/msg/PoseWithCovarianceStamped"
+ODOMETRY = "nav_msgs/msg/Odometry"
 
 
 def _yaw(q) -> float:

@@ -9,6 +9,7 @@ skipped and counted by reason (`GET /api/overlays`), never raised.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import threading
@@ -17,9 +18,12 @@ from typing import Any
 
 from rover_web.config import ConfigError
 from rover_web.core.state import Rover
+from rover_web.ros import cdr
+from rover_web.ros.convert import yaw_from_quaternion
 
 from . import costmap, scan
 from .counts import LayerCounts
+from .frames import OdomInMap, compose
 from .markers import MAP_FRAMES, ROBOT_FRAMES, BadMarker, MarkerSet
 from .poses import PoseHistory
 
@@ -60,6 +64,7 @@ class OverlayService:
         self.markers_max_hz = config["ROVER_WEB_MARKERS_MAX_HZ"]
         self.map_frames = {*MAP_FRAMES, config["ROVER_WEB_GOAL_FRAME_ID"]}
         self.poses = PoseHistory(keep_s=config["ROVER_WEB_LIVEMAP_TRAIL_S"])
+        self.odom_frame = OdomInMap()
         self.counts = {
             "scan": LayerCounts("scan", [self.scan_topic] if self.scan_topic else []),
             "costmap": LayerCounts("costmap", self.costmap_topics),
@@ -79,6 +84,16 @@ class OverlayService:
     def on_pose(self, stamp: float, x: float, y: float, yaw: float) -> None:
         if all(map(math.isfinite, (stamp, x, y, yaw))):
             self.poses.add(stamp, x, y, yaw)
+            self.odom_frame.on_map_pose(stamp, (x, y, yaw))
+
+    def on_odom(self, raw: bytes) -> None:
+        """The odometry's pose, for placing grids and footprints given in its frame (frames.py)."""
+        try:
+            f = cdr.odometry(raw)
+        except cdr.NotPlainCdr:
+            return
+        self.odom_frame.on_odom(f.frame_id, f.sec + f.nanosec * 1e-9,
+                                (f.x, f.y, yaw_from_quaternion(f.qx, f.qy, f.qz, f.qw)))
 
     # --- scan ---
 
@@ -118,8 +133,11 @@ class OverlayService:
             counts.skip(str(exc))
             return
         if grid.frame_id.lstrip("/") not in self.map_frames:
-            counts.skip("unknown_frame")
-            return
+            map_t_odom = self.odom_frame.transform(grid.frame_id)
+            if map_t_odom is None:
+                counts.skip("unknown_frame")
+                return
+            grid = dataclasses.replace(grid, frame_id="map", origin=compose(map_t_odom, grid.origin))
         with self._grids_lock:
             self._pending[topic] = grid  # the encoding loop takes the newest
 
@@ -200,6 +218,8 @@ class OverlayService:
             x0, y0, yaw = robot
             c, s = math.cos(yaw), math.sin(yaw)
             polygon = [(x0 + c * x - s * y, y0 + s * x + c * y) for x, y in points]
+        elif (map_t_odom := self.odom_frame.transform(frame)) is not None:
+            polygon = [compose(map_t_odom, (x, y, 0.0))[:2] for x, y in points]
         else:
             counts.skip("unknown_frame")
             return

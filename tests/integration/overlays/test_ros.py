@@ -207,3 +207,31 @@ def test_the_simulator_publishes_every_layer(live_server, sim_process, sse_clien
     # Nothing the simulator sends is bad (a scan heard before its first pose cannot be placed, though).
     assert set(trail["layers"]["scan"]["skipped_by_reason"]) <= {"no_pose"}
     assert trail["layers"]["costmap"]["skipped"] == 0 and trail["layers"]["markers"]["skipped"] == 0
+
+
+def test_a_local_costmap_and_footprint_in_odom_are_placed_with_amcl_s_map_to_odom(live_server, posed, sse_client):
+    """Nav2's local costmap and footprint are in `odom`: placed as AMCL's map -> odom puts them."""
+    stream = sse_client(live_server.url + "/api/events?channels=costmap,footprint")
+    posed.advertise("/odom", "nav_msgs/msg/Odometry")
+    posed.advertise("/local_costmap/costmap", GRID, qos="latched")
+    # Odometry has the robot 1 m along odom's x; AMCL has it at (10, 10) facing map +y (the fixture):
+    # map_T_odom is then (10, 9) turned by +90 degrees.
+    odom = {"header": {"frame_id": "odom"}, "child_frame_id": "base_link",
+            "pose": {"pose": {"position": {"x": 1.0}, "orientation": {"w": 1.0}}}}
+    posed.wait_match("/odom")
+    grid = {**costmap(20, 10, origin=(1.0, 2.0)), "header": {"frame_id": "odom"}}
+
+    def placed():
+        posed.publish("/odom", odom)
+        posed.publish("/local_costmap/costmap", grid)
+        return next((e["json"] for e in reversed(stream.of("costmap"))
+                     if any(c["topic"] == "/local_costmap/costmap" for c in e["json"]["costmaps"])), None)
+    event = wait_until(placed, timeout=15, interval=0.3, what="the local costmap placed")
+    layer = next(c for c in event["costmaps"] if c["topic"] == "/local_costmap/costmap")
+    assert layer["origin"][0] == pytest.approx(8.0, abs=1e-3) and layer["origin"][1] == pytest.approx(10.0, abs=1e-3)
+    assert layer["origin"][2] == pytest.approx(math.pi / 2, abs=1e-4)
+    posed.advertise("/global_costmap/published_footprint", POLYGON)
+    square = {"header": {"frame_id": "odom"},
+              "polygon": {"points": [{"x": 1.0, "y": 0.0}, {"x": 2.0, "y": 0.0}, {"x": 2.0, "y": 1.0}]}}
+    foot = publish_until(posed, "/global_costmap/published_footprint", square, stream, "footprint")
+    assert foot["polygon"] == [[10.0, 10.0], [10.0, 11.0], [9.0, 11.0]]
