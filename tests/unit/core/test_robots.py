@@ -3,7 +3,16 @@
 import pytest
 
 from rover_web import config
-from rover_web.core.robots import DEFAULT_NAME, Robot, RobotsError, from_text, kind_from_name, parse, settings_for
+from rover_web.core.robots import (
+    DEFAULT_NAME,
+    NAME_LISTS,
+    Robot,
+    RobotsError,
+    from_text,
+    kind_from_name,
+    parse,
+    settings_for,
+)
 
 
 def test_empty_is_the_one_robot_of_old_without_a_namespace():
@@ -87,7 +96,9 @@ def test_settings_for_resolves_every_topic_and_name_list():
         key = config.PREFIX + setting.name
         if setting.kind in ("topic", "optional_topic") and settings[key]:
             assert mine[key] == boat.resolve(settings[key]), key
-        elif key not in ("ROVER_WEB_LINK_TOPICS", "ROVER_WEB_ESTOP_CANCEL_ACTIONS"):
+        elif key in NAME_LISTS:  # lists of names, each resolved
+            assert mine[key] == [boat.resolve(name) for name in settings[key]], key
+        else:
             assert mine[key] == settings[key], key
     assert settings["ROVER_WEB_CMD_VEL_TOPIC"] == "/cmd_vel"  # the shared settings are left alone
 
