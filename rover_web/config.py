@@ -392,6 +392,9 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("RECORDING_QUEUE", 10000, "int",
             "messages waiting for the recording's writer thread; beyond, new ones are counted as dropped", 100,
             1000000),
+    Setting("RECORDING_UPLOAD_MAX_MB", 1024.0, "float",
+            "largest MCAP file an operator may upload to replay (MB; 413 beyond); uploads count towards "
+            "ROVER_WEB_RECORDINGS_MAX_MB", 0.01, 1e7),
 )
 
 _BY_NAME = {PREFIX + s.name: s for s in SETTINGS}

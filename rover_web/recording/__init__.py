@@ -7,9 +7,13 @@ HTTP (routes.py):
   POST   /api/recordings/<id>/stop        stop (operator)
   GET    /api/recordings/<id>/file        download, with HTTP Range
   DELETE /api/recordings/<id>             delete (admin)
+  POST   /api/recordings/upload           an MCAP file from elsewhere, to replay (operator)
+  GET    /recordings/<id>/replay          the replay view; its data: GET /api/recordings/<id>/timeline,
+         .../fields, .../series, .../diagnostics, .../frame (replay_routes.py)
 Modules: schema (ros2msg schema text), recorder (the writer thread and the MCAP file), service
 (choosing topics, raw subscriptions, the audit trail, limits), store (the SQLite index), reading
-(a file whole or cut short), replay (`flask --app rover_web replay FILE`).
+(a file whole or cut short), replay (`flask --app rover_web replay FILE`), file_index (a file's
+chunk map), timeline and replay_data (the replay view's answers), upload.
 """
 
 from __future__ import annotations
@@ -42,7 +46,7 @@ def recordings_folder(app) -> Path:
 
 
 def init_app(app, fleet: Fleet) -> None:
-    from . import routes
+    from . import replay_routes, routes  # noqa: F401 - replay_routes adds its routes to routes.bp
     from .service import RecordingService, parse_presets
     from .store import RecordingIndex
 

@@ -20,8 +20,10 @@ from mcap.records import Channel, Footer, Message, Schema
 from mcap.stream_reader import StreamReader
 
 MAGIC = b"\x89MCAP0\r\n"
-# What the stream reader raises where the bytes stop or stop making sense (CRCValidationError is a ValueError).
-CUT_OR_DAMAGED = (EndOfFile, InvalidMagic, McapError, struct.error, zlib.error, zstandard.ZstdError, ValueError)
+# What the stream reader raises where the bytes stop or stop making sense (CRCValidationError is a ValueError;
+# the lz4 package says a damaged or cut frame with a RuntimeError).
+CUT_OR_DAMAGED = (EndOfFile, InvalidMagic, McapError, struct.error, zlib.error, zstandard.ZstdError, ValueError,
+                  RuntimeError)
 
 
 class NotARecording(ValueError):

@@ -1,12 +1,13 @@
 """Recorder: one MCAP file being written, by its own thread, from a bounded queue.
 
-ROS callbacks (on the executor) and audit listeners (on request threads) only `offer` a message:
-an append to a deque, which never waits and wakes nobody. The writer takes what came every
-BATCH_S: a queue.Queue woke it (a lock and a notify on the executor thread) for every message,
-the executor's largest recording cost in a profile of bench/recording.py. A full queue means the
-disk or the writer fell behind; the message is counted as dropped for its topic instead of
-stalling the executor, which also serves teleop and the e-stop. The writer thread owns the mcap
-Writer: chunked, zstd, and flushed (chunk closed, bytes handed to the OS) every FLUSH_S, so a
+The raw taker's thread (ros/raw_taker.py, for the topics) and audit listeners (on request
+threads) only `offer` a message: an append to a deque, which never waits and wakes nobody. The
+writer takes what came every BATCH_S: a queue.Queue woke it (a lock and a notify on the taking
+thread) for every message, once the largest recording cost in a profile of bench/recording.py. A
+full queue means the disk or the writer fell behind; the message is counted as dropped for its
+topic instead of stalling the thread that took it. The writer thread owns the mcap Writer:
+chunked, lz4 (zstd took a third of this thread's time with the camera, for 7 % smaller noisy
+frames: docs/recording.md), and flushed (chunk closed, bytes handed to the OS) every FLUSH_S, so a
 process killed mid-recording leaves a file readable up to its last flushed chunk
 (docs/recording.md#crash-safety).
 """
@@ -51,7 +52,7 @@ class Recorder:
         schemas = {type_name: schema_text(type_name) for type_name in set(channels.values())}
         self.path = path
         self.limits = limits
-        self._pending: deque = deque()  # append and popleft are atomic: no lock on the executor's path
+        self._pending: deque = deque()  # append and popleft are atomic: no lock on the taking thread's path
         self._queue_size = queue_size
         self._wake = threading.Event()
         self._on_progress = on_progress
@@ -64,7 +65,7 @@ class Recorder:
         self.started_ns = time.time_ns()
         self.ended_ns: int | None = None
         self._stream = open(path, "xb")  # noqa: SIM115 - owned by the writer thread, closed at its end
-        self._writer = Writer(self._stream, chunk_size=CHUNK_BYTES, compression=CompressionType.ZSTD)
+        self._writer = Writer(self._stream, chunk_size=CHUNK_BYTES, compression=CompressionType.LZ4)
         # profile "ros2" and schema names "pkg/msg/Type", as rosbag2's MCAP plugin writes them.
         self._writer.start(profile="ros2", library="rover_web")
         schema_ids = {t: self._writer.register_schema(name=t, encoding="ros2msg", data=text.encode())

@@ -1,5 +1,6 @@
 """The recordings' REST API. Viewers list and download, operators record, admins delete
-(rover_web/auth/policy.py decides by method, and names the DELETE an admin endpoint)."""
+(rover_web/auth/policy.py decides by method, and names the DELETE an admin endpoint). The replay
+view's page, its data routes and the upload are in replay_routes.py, on the same blueprint."""
 
 from __future__ import annotations
 
@@ -67,7 +68,8 @@ def parse_selection(body: dict) -> Selection:
 def recordings_page():
     """Start and stop (operators), the list with downloads (viewers); static/js/recording/."""
     service = _service()
-    return render_template("recordings.html", presets=sorted(service.presets))
+    return render_template("recordings.html", presets=sorted(service.presets),
+                           upload_max_mb=service.upload_max_bytes / (1024 * 1024))
 
 
 @bp.get("/api/recordings")
@@ -106,32 +108,6 @@ def recording_file(recording_id: str):
     # conditional=True: Range requests (206), If-Range, ETag; a viewer such as Foxglove can seek remotely.
     return send_file(path, mimetype="application/octet-stream", as_attachment=True,
                      download_name=f"{recording_id}.mcap", conditional=True, max_age=0)
-
-
-@bp.get("/recordings/<recording_id>/replay")
-def replay_page(recording_id: str):
-    """The replay view: a time slider over the track, the logs and the audit trail; publishes nothing."""
-    from rover_web.waypoints.service import WaypointsService
-
-    status = _service().status(_id(recording_id))
-    # The waypoints map's own settings and offline basemap: the track shows where the robot was.
-    return render_template("recording_replay.html", recording=status,
-                           map_config=current_feature(WaypointsService).map_config())
-
-
-@bp.get("/api/recordings/<recording_id>/timeline")
-def recording_timeline(recording_id: str):
-    from .reading import NotARecording
-    from .timeline import timeline
-
-    service = _service()
-    status = service.status(_id(recording_id))
-    if status["state"] == "recording":
-        raise ApiError(409, "recording_in_progress", "the file is still being written: stop the recording first")
-    try:
-        return jsonify(id=recording_id, **timeline(service.path_of(recording_id)))
-    except NotARecording as exc:
-        raise ApiError(422, "not_a_recording", str(exc)) from None
 
 
 @bp.delete("/api/recordings/<recording_id>")

@@ -19,8 +19,10 @@ from pathlib import Path
 from rover_web.core.state import Rover
 from rover_web.ros.graph import matching_qos, topic_types
 from rover_web.ros.raw import string_cdr
+from rover_web.ros.raw_taker import RawTaker
 from rover_web.web.http import ApiError
 
+from . import file_index, upload
 from .recorder import Limits, Recorder
 from .schema import SchemaNotFound, schema_text
 from .store import RecordingIndex
@@ -64,10 +66,13 @@ class RecordingService:
         self.min_free_bytes = int(config["ROVER_WEB_RECORDINGS_MIN_FREE_MB"] * MB)
         self.camera_period_s = 1.0 / config["ROVER_WEB_RECORDING_CAMERA_MAX_HZ"]
         self.queue_size = config["ROVER_WEB_RECORDING_QUEUE"]
+        self.upload_max_bytes = int(config["ROVER_WEB_RECORDING_UPLOAD_MAX_MB"] * MB)
         self._audit_hubs = [rover.audit, *[hub for hub in extra_audit if hub is not rover.audit]]
         self._lock = threading.Lock()
         self._active: _Active | None = None
+        self._taker: RawTaker | None = None  # made at the first recording
         index.reconcile(folder, rover.robot.name)
+        upload.clear_incoming(folder)
 
     # --- start and stop ---
 
@@ -76,7 +81,7 @@ class RecordingService:
             if self._active is not None:
                 raise ApiError(409, "recording_in_progress", f"recording {self._active.id} is running on "
                                f"{self.rover.robot.name}: stop it first (one recording at a time per robot)")
-            self._check_room()
+            self.check_room()
             channels, skipped, left_out = self._choose(selection)
             recording_id = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime()) + "-" + secrets.token_hex(3)
             path = self.folder / f"{recording_id}.mcap"
@@ -157,6 +162,7 @@ class RecordingService:
         if active is not None and active.id == recording_id:
             raise ApiError(409, "recording_in_progress", "this recording is running: stop it before deleting it")
         path.unlink(missing_ok=True)
+        file_index.forget(path)
         self.index.delete(recording_id)
         self.rover.audit.record("recording.delete", by=by, detail=f"recording {recording_id} deleted",
                                 recording=recording_id)
@@ -206,16 +212,20 @@ class RecordingService:
     def _subscribe(self, active: _Active, channels: dict[str, str]) -> None:
         runtime = self.rover.runtime
         recorder = active.recorder
+        if self._taker is None:
+            # Not the app's executor: its thread serves teleop and the e-stop, and rebuilt its whole
+            # wait set for every recorded message (ros/raw_taker.py says what that cost).
+            self._taker = RawTaker(runtime, "recorder", namespace=self.rover.robot.namespace)
         for topic, type_name in channels.items():
             if type_name in IMAGE_TYPES:
                 callback = _throttled(recorder, topic, self.camera_period_s)
             else:
-                def callback(data: bytes, topic=topic) -> None:
-                    recorder.offer(topic, data)
-            # raw=True: rclpy hands over the CDR bytes as they came; they go into the file unchanged.
-            active.subscriptions.append(runtime.subscribe(type_name, topic, callback,
-                                                          qos=matching_qos(runtime, topic, SUBSCRIPTION_DEPTH),
-                                                          track=False, raw=True))
+                def callback(data: bytes, received_ns: int, topic=topic) -> None:
+                    recorder.offer(topic, data, received_ns)
+            # Raw: the CDR bytes as they came; they go into the file unchanged, logged at the time the
+            # middleware received them (as rosbag2 logs them), not when this thread took them.
+            active.subscriptions.append(self._taker.subscribe(type_name, topic, callback,
+                                                              matching_qos(runtime, topic, SUBSCRIPTION_DEPTH)))
 
         def audit(record: dict) -> None:
             stamp = record["timestamp"]
@@ -232,7 +242,7 @@ class RecordingService:
             unsubscribe()
         for subscription in active.subscriptions:
             try:
-                self.rover.runtime.destroy(subscription)
+                self._taker.unsubscribe(subscription)
             except Exception:  # shutting down: the node may be gone already
                 log.debug("could not destroy a recording subscription", exc_info=True)
 
@@ -255,13 +265,21 @@ class RecordingService:
         if recorder.stop_reason not in ("requested", "shutdown"):
             log.warning("recording %s stopped: %s", recorder.path.stem, recorder.stop_reason)
 
-    def _check_room(self) -> None:
+    def check_room(self, adding: int = 0) -> None:
+        """507 unless the folder and the disk have room for a recording (or an upload of `adding` bytes)."""
         self.folder.mkdir(mode=0o700, parents=True, exist_ok=True)
-        if self._folder_bytes() >= self.folder_max_bytes:
-            raise ApiError(507, "folder_full", "the recordings take ROVER_WEB_RECORDINGS_MAX_MB already: "
-                           "delete some first")
-        if shutil.disk_usage(self.folder).free < self.min_free_bytes:
-            raise ApiError(507, "disk_low", "the disk has less free space than ROVER_WEB_RECORDINGS_MIN_FREE_MB")
+        if self._folder_bytes() + adding >= self.folder_max_bytes:
+            raise ApiError(507, "folder_full", "the recordings take ROVER_WEB_RECORDINGS_MAX_MB already"
+                           + (" with this file" if adding else "") + ": delete some first")
+        if shutil.disk_usage(self.folder).free - adding < self.min_free_bytes:
+            raise ApiError(507, "disk_low", "the disk has less free space than ROVER_WEB_RECORDINGS_MIN_FREE_MB"
+                           + (" once this file is stored" if adding else ""))
+
+    def add_uploaded(self, row: dict) -> None:
+        """An uploaded file's row (upload.py has checked and renamed the file)."""
+        self.index.add({**row, "robot": self.rover.robot.name})
+        self.rover.audit.record("recording.upload", by=row["started_by"],
+                                detail=f"recording {row['id']} uploaded ({row['size']} bytes)", recording=row["id"])
 
     def _folder_bytes(self) -> int:
         return sum(p.stat().st_size for p in self.folder.glob("*.mcap") if p.is_file())
@@ -281,6 +299,7 @@ class RecordingService:
             "selection": selection.get("topics"), "camera": selection.get("camera", False),
             "topics": row["topics"], "counts": counts, "messages": sum(counts.values()), "dropped": dropped,
             "skipped": selection.get("skipped", []), "left_out": selection.get("left_out", []),
+            "source": "uploaded" if "uploaded" in selection else "recorded",
             "file": f"/api/recordings/{row['id']}/file",
         }
 
@@ -288,16 +307,19 @@ class RecordingService:
 def _throttled(recorder: Recorder, topic: str, period_s: float):
     """At most one frame per period_s on average. A token bucket (room for 1.5 frames), not a
     minimum gap: a 10 fps camera recorded at 10 Hz arrives with jitter, and a minimum gap of
-    exactly 0.1 s dropped a third of its frames (bench/recording.py)."""
-    bucket = {"tokens": 1.0, "at": time.monotonic()}
+    exactly 0.1 s dropped a third of its frames (bench/recording.py). Timed by each frame's
+    reception, not by when it was taken: frames that waited and are taken together are still
+    10 Hz frames."""
+    bucket = {"tokens": 1.5, "at": None}  # full: the first frames pass
 
-    def callback(data: bytes) -> None:
-        now = time.monotonic()
-        bucket["tokens"] = min(1.5, bucket["tokens"] + (now - bucket["at"]) / period_s)
+    def callback(data: bytes, received_ns: int) -> None:
+        now = received_ns / 1e9 if received_ns else time.time()
+        last = bucket["at"] if bucket["at"] is not None else now
+        bucket["tokens"] = min(1.5, bucket["tokens"] + max(0.0, now - last) / period_s)
         bucket["at"] = now
         if bucket["tokens"] >= 1.0:
             bucket["tokens"] -= 1.0
-            recorder.offer(topic, data)
+            recorder.offer(topic, data, received_ns)
     return callback
 
 

@@ -140,6 +140,22 @@ def _view_accepts_media() -> tuple[str, ...]:
     return getattr(view, "accepts_media", ())
 
 
+def body_limit(max_bytes):
+    """Mark a view whose body may be larger than ROVER_WEB_MAX_BODY_BYTES (an uploaded file):
+    max_bytes(config) is its limit, which the view checks itself (to say which setting it is),
+    and which reading its body enforces (request.max_content_length)."""
+    def mark(view):
+        view.max_body_bytes = max_bytes
+        return view
+    return mark
+
+
+def _view_body_limit():
+    view = current_app.view_functions.get(request.endpoint) if request.endpoint else None
+    limit_of = getattr(view, "max_body_bytes", None)
+    return limit_of(current_app.config) if limit_of is not None else None
+
+
 def _security_headers(response):
     for name, value in SECURITY_HEADERS.items():
         response.headers.setdefault(name, value)
@@ -163,7 +179,10 @@ def _guard():
                                   f"requests from {origin[:80]} may not control this robot; "
                                   "add it to ROVER_WEB_ALLOWED_ORIGINS")
     limit = config["ROVER_WEB_MAX_BODY_BYTES"]
-    if request.content_length is not None and request.content_length > limit:
+    own_limit = _view_body_limit()
+    if own_limit is not None:
+        request.max_content_length = own_limit  # the view says why it refuses more; reading stops there
+    elif request.content_length is not None and request.content_length > limit:
         # Refuse before routing or reading, whatever the route does with its body.
         return error_response(413, "request_entity_too_large", f"request body is larger than {limit} bytes")
     if (request.method in ("POST", "PUT", "PATCH") and request.mimetype != "application/json"

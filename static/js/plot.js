@@ -4,9 +4,9 @@
 // drag zooms (and pauses), CSV exports every point this page holds.
 import { api, ApiError } from './api.js';
 import { on } from './live.js';
+import { chartWidth, joined, makeChart } from './plot/chart.js';
 
 const KEEP = 20000;  // points per series kept in the page
-const COLOURS = ['#58a6ff', '#e3b341', '#7ee787', '#ff7b72', '#d2a8ff', '#79c0ff', '#ffa657', '#a5d6ff'];
 const $ = (id) => document.getElementById(id);
 const chartEl = $('plot-chart');
 const topicSelect = $('plot-topic');
@@ -66,20 +66,14 @@ function rebuild() {
   if (chart) { chart.destroy(); chart = null; }
   chartEl.replaceChildren();
   if (!series.size) { chartEl.dataset.points = '0'; return; }
-  const opts = {
-    width: Math.max(320, chartEl.clientWidth), height: 420,
-    series: [{}, ...[...series.keys()].map((id, i) => ({ label: id, stroke: COLOURS[i % COLOURS.length], spanGaps: true }))],
-    axes: [{ stroke: '#8b949e' }, { stroke: '#8b949e', size: 60 }],
-    hooks: { setSelect: [(u) => { if (u.select.width > 0) setPaused(true); }] },
-  };
-  chart = new window.uPlot(opts, data(), chartEl);
+  chart = makeChart(chartEl, [...series.keys()], data(), { onSelect: () => setPaused(true) });
 }
 
 function data() {
   const now = Date.now() / 1000;
-  const joined = window.uPlot.join(tables(now - windowS()));
-  chartEl.dataset.points = String(joined[0].length);
-  return joined;
+  const aligned = joined(tables(now - windowS()));
+  chartEl.dataset.points = String(aligned[0].length);
+  return aligned;
 }
 
 function draw() {
@@ -133,11 +127,11 @@ on('plot', (event) => {
 });
 
 function csv() {
-  const joined = window.uPlot.join(tables(-Infinity));
+  const all = joined(tables(-Infinity));
   const quote = (text) => `"${text.replaceAll('"', '""')}"`;
   const lines = [['time_unix_s', ...[...series.keys()].map(quote)].join(',')];
-  for (let i = 0; i < joined[0].length; i++) {
-    lines.push(joined.map((column) => (column[i] === null || column[i] === undefined ? '' : column[i])).join(','));
+  for (let i = 0; i < all[0].length; i++) {
+    lines.push(all.map((column) => (column[i] === null || column[i] === undefined ? '' : column[i])).join(','));
   }
   return `${lines.join('\n')}\n`;
 }
@@ -192,7 +186,7 @@ on('topics', (graph) => {
 setInterval(() => {
   for (const s of series.values()) api('GET', `/api/plot?${query(s.topic, s.field, 1)}`).catch(() => {});
 }, (idleS * 1000) / 3);
-window.addEventListener('resize', () => { if (chart) chart.setSize({ width: Math.max(320, chartEl.clientWidth), height: 420 }); });
+window.addEventListener('resize', () => { if (chart) chart.setSize({ width: chartWidth(chartEl), height: 420 }); });
 
 // /plot?topic=/odom&field=twist.twist.linear.x opens with that series.
 const params = new URLSearchParams(location.search);

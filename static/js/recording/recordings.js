@@ -2,7 +2,7 @@
 // everyone sees the running recording's status (and, once it ends, why) and the list with download
 // links. The list is read from GET /api/recordings every second while the page is open: one small
 // JSON a second, and no event channel to keep for a page few people have open.
-import { api, at } from '../api.js';
+import { api, at, errorFrom } from '../api.js';
 
 const $ = (id) => document.getElementById(id);
 const form = $('rec-form');
@@ -36,6 +36,7 @@ const REASONS = {
 
 function stateText(rec) {
   if (rec.state === 'recording') return 'recording';
+  if (rec.source === 'uploaded') return `uploaded by ${rec.started_by}`;
   return (REASONS[rec.stop_reason] || rec.state) + (rec.error ? ` (${rec.error})` : '');
 }
 
@@ -50,6 +51,7 @@ function row(rec) {
   const tr = document.createElement('tr');
   tr.dataset.id = rec.id;
   tr.dataset.state = rec.state;
+  tr.dataset.source = rec.source;
   tr.append(cell(rec.name || rec.id), cell(new Date(rec.started_at * 1000).toLocaleString()),
     cell(duration(rec.duration_s), 'num'), cell(mb(rec.size), 'num'), cell(String(Object.keys(rec.topics).length), 'num'),
     cell(String(rec.messages), 'num'), cell(stateText(rec)));
@@ -165,6 +167,40 @@ async function removeRecording(rec) {
   }
   refresh();
 }
+
+// Upload: the file itself is the body (the server checks it whole before keeping it).
+$('rec-upload-form').addEventListener('submit', async (event) => {
+  event.preventDefault();
+  const file = $('rec-upload-file').files[0];
+  const said = $('rec-upload-status');
+  if (!file) return;
+  const name = $('rec-upload-name').value.trim() || file.name.replace(/\.mcap$/i, '');
+  const most = Number($('rec-upload-form').dataset.maxBytes);
+  if (file.size > most) {  // said here: a server refusing a large body early may reach the page as a reset
+    said.dataset.state = 'refused';
+    said.textContent = `Not uploaded: ${file.name} is ${mb(file.size)}, over ROVER_WEB_RECORDING_UPLOAD_MAX_MB `
+      + `(${mb(most)}).`;
+    return;
+  }
+  said.dataset.state = 'sending';
+  said.textContent = `Uploading ${file.name} (${mb(file.size)})…`;
+  $('rec-upload').disabled = true;
+  try {
+    const response = await fetch(at(`/api/recordings/upload?${new URLSearchParams({ name })}`), {
+      method: 'POST', headers: { 'Content-Type': 'application/octet-stream', Accept: 'application/json' }, body: file });
+    if (!response.ok) throw await errorFrom(response);
+    const made = await response.json();
+    said.dataset.state = 'done';
+    said.textContent = `${made.name || made.id} uploaded: ${made.messages} messages, ${duration(made.duration_s)}.`;
+    $('rec-upload-form').reset();
+  } catch (err) {
+    said.dataset.state = 'refused';
+    said.textContent = `Not uploaded: ${err.message}`;
+  } finally {
+    $('rec-upload').disabled = false;
+  }
+  refresh();
+});
 
 refresh();
 setInterval(() => { if (!document.hidden) refresh(); }, POLL_MS);

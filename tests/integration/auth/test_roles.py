@@ -48,6 +48,7 @@ REQUESTS = [
     ("POST", "/api/recordings", {"topics": "all"}, "operator", "/api/recordings"),
     ("POST", "/api/recordings/nosuch/stop", {}, "operator", "/api/recordings/<recording_id>/stop"),
     ("DELETE", "/api/recordings/nosuch", None, "admin", "/api/recordings/<recording_id>"),
+    ("POST", "/api/recordings/upload", {}, "operator", "/api/recordings/upload"),
     ("POST", "/api/me/sessions/revoke", {}, "viewer", "/api/me/sessions/revoke"),  # tokens stay valid
     ("POST", "/api/camera/whep?topic=/camera/image_raw", {}, "viewer", "/api/camera/whep"),
     ("DELETE", "/api/camera/whep/nosuchsession", None, "viewer", "/api/camera/whep/<session_id>"),
@@ -73,6 +74,8 @@ ANSWERED_WITHOUT_A_PEER = {
     # Stopping or deleting names a recording (tests/integration/recording/test_recording.py).
     "/api/recordings/<recording_id>/stop": (404, "not_found"),
     "/api/recordings/<recording_id>": (404, "not_found"),
+    # An upload's body is the MCAP file (tests/integration/recording/test_upload.py): JSON is not one.
+    "/api/recordings/upload": (422, "not_mcap"),
 }
 RANK = {None: -1, "viewer": 0, "operator": 1, "admin": 2}
 PUBLIC = {("POST", "/login"), ("POST", "/login/estop")}  # tests/integration/estop/test_estop_all.py

@@ -182,7 +182,9 @@ def test_a_subscription_rclpy_refuses_ends_the_recording_cleanly_and_says_why(ap
     def refuse(*args, **kwargs):
         raise RuntimeError("rmw said no")
 
-    monkeypatch.setattr(runtime, "subscribe", refuse)
+    from rover_web.ros.raw_taker import RawTaker
+
+    monkeypatch.setattr(RawTaker, "subscribe", refuse)
     answer = client.post("/api/recordings", json={"topics": "all"})
     assert answer.status_code == 503 and answer.json["error"] == "subscribe_failed"
     (listed,) = client.get("/api/recordings").json["recordings"]

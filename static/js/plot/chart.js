@@ -1,0 +1,41 @@
+// The plot page's chart, shared with the replay view: uPlot (vendored, window.uPlot) with one time
+// axis for every series (uPlot.join aligns them), the page's colours and axes. A drag across the
+// chart selects (onSelect), a double click zooms out; `marker` draws a vertical line at a time.
+
+export const COLOURS = ['#58a6ff', '#e3b341', '#7ee787', '#ff7b72', '#d2a8ff', '#79c0ff', '#ffa657', '#a5d6ff'];
+export const MARKER_COLOUR = '#f85149';
+
+export const chartWidth = (el) => Math.max(320, el.clientWidth);
+
+// tables: one [t[], v[]] per series, in the order of `labels`.
+export const joined = (tables) => window.uPlot.join(tables);
+
+// labels: the series' names. options: { height, onSelect(u), marker() -> a time or null }.
+export function makeChart(el, labels, data, { height = 420, onSelect = null, marker = null } = {}) {
+  const hooks = {};
+  if (onSelect) hooks.setSelect = [(u) => { if (u.select.width > 0) onSelect(u); }];
+  if (marker) {
+    hooks.draw = [(u) => {
+      const t = marker();
+      if (t === null || t === undefined) return;
+      const x = u.valToPos(t, 'x', true);
+      if (x < u.bbox.left || x > u.bbox.left + u.bbox.width) return;
+      const { ctx } = u;
+      ctx.save();
+      ctx.strokeStyle = MARKER_COLOUR;
+      ctx.lineWidth = 2 * (window.devicePixelRatio || 1);
+      ctx.beginPath();
+      ctx.moveTo(x, u.bbox.top);
+      ctx.lineTo(x, u.bbox.top + u.bbox.height);
+      ctx.stroke();
+      ctx.restore();
+    }];
+  }
+  const opts = {
+    width: chartWidth(el), height,
+    series: [{}, ...labels.map((label, i) => ({ label, stroke: COLOURS[i % COLOURS.length], spanGaps: true }))],
+    axes: [{ stroke: '#8b949e' }, { stroke: '#8b949e', size: 60 }],
+    hooks,
+  };
+  return new window.uPlot(opts, data, el);
+}
