@@ -1,4 +1,4 @@
-"""Print the README's settings table from rover_web/config.py (the one place defaults live)."""
+"""Print the README's settings table from rover_web/settings.py (the one place defaults live)."""
 
 import json
 import sys

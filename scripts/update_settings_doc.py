@@ -1,4 +1,4 @@
-"""Rewrite the settings table in docs/configuration.md from rover_web/config.py."""
+"""Rewrite the settings table in docs/configuration.md from rover_web/settings.py."""
 
 import subprocess
 import sys
