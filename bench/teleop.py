@@ -1,6 +1,7 @@
 """Teleop: WebSocket frame -> Twist on /cmd_vel in a separate rclpy process; close -> zero; rate jitter.
 
     .venv/bin/python bench/teleop.py [--frames 2000] [--block 250] [--trials 100] [--hold-s 10]
+                                     [--overlays 10 | --recording]
 
 1. frame -> topic: `--frames` joystick frames at 40 Hz, each a new value, from a WebSocket client
    to the app (`flask run` in its own process); latency is the moment the (already framed and
@@ -29,7 +30,18 @@ import tempfile
 import threading
 import time
 
-from common import ROOT, Server, machine, percentile, ros_env, summary_ms
+from common import (
+    ROOT,
+    Server,
+    SseFleet,
+    machine,
+    percentile,
+    ros_env,
+    start_peer,
+    stop_process,
+    summary_ms,
+    wait_for_topic,
+)
 
 MAX_LINEAR = 5.0
 RATE_HZ = 40.0
@@ -300,6 +312,62 @@ class Baseline:
         self.context.try_shutdown()
 
 
+class OverlayLoad:
+    """LiveMap's overlays flowing to `viewers` SSE clients while the teleop figures are taken."""
+
+    def __init__(self, url: str, env: dict, viewers: int):
+        self.fleet = SseFleet(url, "/api/events?channels=scan,costmap", viewers)
+        self.events = 0
+        self.pub = start_peer("overlay_publisher.py", env, "--seconds", "3600")
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._read, daemon=True)
+        self._thread.start()
+        print(f"# meanwhile: overlays to {viewers} viewers", flush=True)
+
+    def _count(self, *_args) -> None:
+        self.events += 1
+
+    def _read(self) -> None:
+        while not self._stop.is_set():
+            self.fleet.poll(0.5, self._count)
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join(5)
+        stop_process(self.pub)
+        self.fleet.close()
+        print(f"# overlay events received by the viewers: {self.events}", flush=True)
+
+
+class RecordingLoad:
+    """A recording of bench/recording.py's 20 topics, the camera's included, while the teleop figures are taken."""
+
+    def __init__(self, server: Server, env: dict):
+        import requests
+        from recording import RATES
+
+        self.url = server.url
+        self.pub = subprocess.Popen([sys.executable, str(ROOT / "bench" / "recording.py"), "--publish"], cwd=ROOT,
+                                    env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        if "publishing" not in self.pub.stdout.readline():
+            raise RuntimeError("the recording bench's publisher did not start")
+        for topic in RATES:
+            wait_for_topic(server, topic, f"{topic} discovered")
+        answer = requests.post(self.url + "/api/recordings", json={"topics": list(RATES), "camera": True}, timeout=10)
+        answer.raise_for_status()
+        self.id = answer.json()["id"]
+        print(f"# meanwhile: recording {len(RATES)} topics with the camera", flush=True)
+
+    def stop(self) -> None:
+        import requests
+
+        done = requests.post(f"{self.url}/api/recordings/{self.id}/stop", json={}, timeout=30).json()
+        self.pub.stdin.close()
+        stop_process(self.pub)
+        print(f"# recorded {sum(done['counts'].values())} messages in {done['duration_s']:.0f} s, "
+              f"dropped {sum(done['dropped'].values())}", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--frames", type=int, default=2000)
@@ -307,15 +375,26 @@ def main() -> None:
     parser.add_argument("--trials", type=int, default=100)
     parser.add_argument("--hold-s", type=float, default=10.0)
     parser.add_argument("--no-baseline", action="store_true")
+    parser.add_argument("--overlays", type=int, default=0, metavar="VIEWERS",
+                        help="meanwhile, LiveMap's overlay load (bench/overlay_publisher.py: a 1,080-beam scan at "
+                             "20 Hz and a 400x400 costmap at 1 Hz) to this many SSE viewers (issue 30)")
+    parser.add_argument("--recording", action="store_true",
+                        help="meanwhile, a recording of bench/recording.py's 20 topics with the camera (issue 28)")
     args = parser.parse_args()
     scratch = tempfile.TemporaryDirectory(prefix="rover_web-bench-teleop-")
     # Its own database: the bench must never read or change a real e-stop latch.
-    env = ros_env(ROVER_WEB_DB_PATH=os.path.join(scratch.name, "bench.sqlite3"))
+    env = ros_env(ROVER_WEB_DB_PATH=os.path.join(scratch.name, "bench.sqlite3"),
+                  ROVER_WEB_RECORDINGS_DIR=scratch.name, ROVER_WEB_RECORDING_CAMERA_MAX_HZ="10",
+                  ROVER_WEB_RECORDINGS_MIN_FREE_MB="100")
     print(f"# teleop bench on {machine()}: app in its own process, subscriber in another "
           f"(ROS domain {env['ROS_DOMAIN_ID']})", flush=True)
     server = Server(env)
-    sub = baseline = None
+    sub = baseline = load = None
     try:
+        if args.overlays:
+            load = OverlayLoad(server.url, env, args.overlays)
+        elif args.recording:
+            load = RecordingLoad(server, env)
         sub = Subscriber(env)
         deadline = time.monotonic() + 10
         import requests
@@ -329,6 +408,8 @@ def main() -> None:
         bench_close(server, sub, args.trials)
         bench_rate(server, sub, args.hold_s)
     finally:
+        if load:
+            load.stop()
         if baseline:
             baseline.close()
         if sub:
