@@ -4,6 +4,7 @@ driving the simulated rover, and the whole dashboard over HTTPS with a self-sign
 import sys
 
 import pytest
+from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
 from rover_web.auth.tls import write_self_signed
 from rover_web.estop import EStopService
@@ -34,17 +35,19 @@ def test_sign_in_and_sign_out(signed_server, page):
     page.fill("input[name=password]", PASSWORD)
     page.click("button[type=submit]")
     page.wait_for_url("**/livemap/**", wait_until="commit")  # /livemap goes on to the default map
-    # The bar fits itself as its pills fill in: the user may be in the bar or, a moment later, in its menu.
+    assert "operator" in page.locator(".whoami").text_content()
+    # The bar fits itself as the page and its pills fill in (and closes its menu when it refits): the
+    # user may be in the bar or in the menu, so open the menu whenever it is closed until the click lands.
     sign_out = page.locator(".whoami button")
-    for _ in range(50):
-        if sign_out.is_visible():
-            break
+    for attempt in range(20):
         menu = page.locator("#topbar-menu")
-        if menu.is_visible() and menu.get_attribute("open") is None:
+        if not sign_out.is_visible() and menu.is_visible() and menu.get_attribute("open") is None:
             page.click("#topbar-menu > summary")
-        page.wait_for_timeout(100)
-    assert "operator" in page.locator(".whoami").inner_text()
-    sign_out.click()
+        try:
+            sign_out.click(timeout=1000)
+            break
+        except PlaywrightTimeout:
+            assert attempt < 19, "Sign out never became clickable"
     page.wait_for_url("**/login", wait_until="commit")
     page.goto(signed_server.url + "/")
     assert "/login" in page.url

@@ -55,7 +55,10 @@ def test_on_a_desktop_cards_are_dragged_resized_added_set_up_undone_and_saved(li
         column = page.locator("#editor-grid").bounding_box()["width"] / 12
         drag(page, robot, 4 * column, 0)  # four columns right: x 4 -> 8
         page.wait_for_selector(f"{robot}[gs-x='8']", timeout=5000)
+        # gridstack shows a card's resize handle while the pointer is over the card.
         handle = page.locator(f"{robot} .ui-resizable-se")
+        page.hover(robot)
+        handle.wait_for(state="visible", timeout=5000)
         hb = handle.bounding_box()
         page.mouse.move(hb["x"] + hb["width"] / 2, hb["y"] + hb["height"] / 2)
         page.mouse.down()

@@ -99,6 +99,7 @@ WALL_CLOCK_ALLOWED = {
     "sim/timecode.py": "the time code is the camera's wall clock, read against the viewer's: glass to glass",
     "hub/stop_all.py": "when a stop-all was sent, shown to people",
     "recording/service.py": "a running recording's duration, from its start kept on disk across restarts",
+    "recording/upload.py": "an upload's id and when it was uploaded, shown to people",
     "zenoh_link/signing.py": "a signed stop's and summary's time, checked on another machine (monotonic clocks are "
                              "each machine's own); lost and stale on the hub use the monotonic clock",
 }
