@@ -26,6 +26,7 @@ from rover_web.plot.field import finite, parse_path, read_number
 from rover_web.plot.service import NOT_PLOTTABLE
 
 from .file_index import FileIndex, stride_for
+from .timeline import decode_sampled
 
 MAX_FIELDS = 8
 SERIES_POINTS = 5000
@@ -127,16 +128,10 @@ def series(index: FileIndex, topic: str, field_paths: list[str]) -> dict:
 
 
 def _read_series(index: FileIndex, topic: str, steps: dict) -> dict:
-    count = index.count([topic])
-    stride = stride_for(count, SERIES_POINTS)
-    rows: list[tuple[float, list]] = []
     skipped = 0
-    for i, (_channel, message) in enumerate(index.messages([topic])):
-        if i % stride:
-            continue
-        decoded = index.decode(message)
-        if decoded is None:
-            continue
+
+    def values_of(decoded) -> dict:
+        nonlocal skipped
         values = []
         for path in steps.values():
             try:
@@ -147,11 +142,12 @@ def _read_series(index: FileIndex, topic: str, steps: dict) -> dict:
                 skipped += 1
                 value = None
             values.append(value)
-        rows.append((message.log_time / 1e9, values))
-    rows.sort(key=lambda row: row[0])
-    names = list(steps)
-    return {"topic": topic, "type": index.type_of(topic), "t": [t for t, _ in rows],
-            "v": {name: [values[k] for _, values in rows] for k, name in enumerate(names)},
+        return {"values": values}
+
+    count = index.count([topic])
+    rows = decode_sampled(index, topic, values_of, SERIES_POINTS)
+    return {"topic": topic, "type": index.type_of(topic), "t": [row["t"] for row in rows],
+            "v": {name: [row["values"][k] for row in rows] for k, name in enumerate(steps)},
             "count": count, "decoded": len(rows), "skipped_nonfinite": skipped}
 
 
