@@ -4,7 +4,7 @@
 // drag zooms (and pauses), CSV exports every point this page holds.
 import { api, ApiError } from './api.js';
 import { on } from './live.js';
-import { chartWidth, joined, makeChart } from './plot/chart.js';
+import { chartWidth, joined, makeChart, seriesItems } from './plot/chart.js';
 
 const KEEP = 20000;  // points per series kept in the page
 const $ = (id) => document.getElementById(id);
@@ -88,18 +88,7 @@ function scheduleDraw() {
 
 function renderList() {
   $('plot-empty').hidden = series.size > 0;  // what to do, until something is plotted
-  $('plot-series').replaceChildren(...[...series.keys()].map((id) => {
-    const li = document.createElement('li');
-    li.dataset.series = id;
-    li.append(id);
-    const remove = document.createElement('button');
-    remove.type = 'button';
-    remove.textContent = '×';
-    remove.title = `remove ${id}`;
-    remove.addEventListener('click', () => { series.delete(id); renderList(); rebuild(); });
-    li.append(remove);
-    return li;
-  }));
+  $('plot-series').replaceChildren(...seriesItems([...series.keys()], (id) => { series.delete(id); renderList(); rebuild(); }));
 }
 
 function query(topic, field, seconds) {

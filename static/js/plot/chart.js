@@ -39,3 +39,19 @@ export function makeChart(el, labels, data, { height = 420, onSelect = null, mar
   };
   return new window.uPlot(opts, data, el);
 }
+
+// The list of plotted series, each with its × to remove it (the Plot page's and the replay's).
+export function seriesItems(ids, onRemove) {
+  return ids.map((id) => {
+    const li = document.createElement('li');
+    li.dataset.series = id;
+    li.append(id);
+    const remove = document.createElement('button');
+    remove.type = 'button';
+    remove.textContent = '×';
+    remove.title = `remove ${id}`;
+    remove.addEventListener('click', () => onRemove(id));
+    li.append(remove);
+    return li;
+  });
+}

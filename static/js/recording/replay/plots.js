@@ -3,7 +3,7 @@
 // at that time beside it. Fields and series come from the recording (GET .../fields, .../series),
 // read and thinned on the server.
 import { api, ApiError } from '../../api.js';
-import { chartWidth, joined, makeChart } from '../../plot/chart.js';
+import { chartWidth, joined, makeChart, seriesItems } from '../../plot/chart.js';
 import { lastIndexAtOrBefore } from './at.js';
 
 const HEIGHT = 280;
@@ -33,18 +33,7 @@ export function createPlots(recordingId, data, els) {
   }
 
   function renderList() {
-    els.list.replaceChildren(...[...series.keys()].map((id) => {
-      const li = document.createElement('li');
-      li.dataset.series = id;
-      li.append(id);
-      const remove = document.createElement('button');
-      remove.type = 'button';
-      remove.textContent = '×';
-      remove.title = `remove ${id}`;
-      remove.addEventListener('click', () => { series.delete(id); rebuild(); });
-      li.append(remove);
-      return li;
-    }));
+    els.list.replaceChildren(...seriesItems([...series.keys()], (id) => { series.delete(id); rebuild(); }));
   }
 
   function showValues() {
