@@ -92,7 +92,7 @@ class OverlayService:
             f = cdr.odometry(raw)
         except cdr.NotPlainCdr:
             return
-        self.odom_frame.on_odom(f.frame_id, f.sec + f.nanosec * 1e-9,
+        self.odom_frame.on_odom(f.frame_id, f.stamp,
                                 (f.x, f.y, yaw_from_quaternion(f.qx, f.qy, f.qz, f.qw)))
 
     # --- scan ---

@@ -38,6 +38,10 @@ class OdometryFields(NamedTuple):
     linear_x: float
     angular_z: float
 
+    @property
+    def stamp(self) -> float:
+        return self.sec + self.nanosec * 1e-9
+
 
 def _string(buf: memoryview, offset: int, order: str) -> tuple[str, int]:
     offset = (offset + 3) & ~3

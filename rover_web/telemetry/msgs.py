@@ -26,18 +26,23 @@ def battery_summary(msg) -> dict:
     }
 
 
+def _summary(x, y, qx, qy, qz, qw, linear, angular, frame_id, stamp) -> dict:
+    return {
+        "x": round(x, 3),
+        "y": round(y, 3),
+        "yaw": round(yaw_from_quaternion(qx, qy, qz, qw), 4),
+        "linear": round(linear, 3),
+        "angular": round(angular, 3),
+        "frame_id": frame_id,
+        "stamp": stamp,
+    }
+
+
 def odom_summary(msg) -> dict:
     pose, twist = msg.pose.pose, msg.twist.twist
     q = pose.orientation
-    return {
-        "x": round(pose.position.x, 3),
-        "y": round(pose.position.y, 3),
-        "yaw": round(yaw_from_quaternion(q.x, q.y, q.z, q.w), 4),
-        "linear": round(twist.linear.x, 3),
-        "angular": round(twist.angular.z, 3),
-        "frame_id": msg.header.frame_id,
-        "stamp": stamp_to_float(msg.header.stamp),
-    }
+    return _summary(pose.position.x, pose.position.y, q.x, q.y, q.z, q.w, twist.linear.x, twist.angular.z,
+                    msg.header.frame_id, stamp_to_float(msg.header.stamp))
 
 
 def odom_summary_cdr(raw: bytes) -> dict:
@@ -46,12 +51,4 @@ def odom_summary_cdr(raw: bytes) -> dict:
         f = cdr.odometry(raw)
     except cdr.NotPlainCdr:
         return odom_summary(cdr.deserialize(raw, ODOMETRY))
-    return {
-        "x": round(f.x, 3),
-        "y": round(f.y, 3),
-        "yaw": round(yaw_from_quaternion(f.qx, f.qy, f.qz, f.qw), 4),
-        "linear": round(f.linear_x, 3),
-        "angular": round(f.angular_z, 3),
-        "frame_id": f.frame_id,
-        "stamp": f.sec + f.nanosec * 1e-9,
-    }
+    return _summary(f.x, f.y, f.qx, f.qy, f.qz, f.qw, f.linear_x, f.angular_z, f.frame_id, f.stamp)
