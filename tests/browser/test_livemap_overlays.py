@@ -6,6 +6,7 @@ import math
 import time
 
 import pytest
+import requests
 
 from tests.browser.test_livemap import BASEMENT, CATALOG, B, amcl, canvas_rgb, open_map, state
 
@@ -110,6 +111,12 @@ def test_every_overlay_is_drawn_where_its_coordinates_say_and_each_toggles(live_
     for y in (2.0, 2.5, 3.0, 3.5, 4.0, 4.5, 5.0, 5.5, 6.0):
         sensing.publish("/amcl_pose", amcl(20.0, y))
         time.sleep(0.05)
+    # The page reads the history once, then adds live poses, which a loaded machine may coalesce:
+    # open it when the server holds the whole drive.
+    deadline = time.monotonic() + 15
+    while len(requests.get(f"{live_server.url}/api/overlays", timeout=5).json()["trail"]) < 9:
+        assert time.monotonic() < deadline, "the server never held the nine poses published"
+        time.sleep(0.1)
     open_map(page, live_server.url)
     s = feed_until_drawn(page, sensing)
     layers = s["layers"]
