@@ -143,7 +143,9 @@ def test_stick_drives_only_while_enable_is_held_and_release_or_unplug_stops(rig,
     assert_stops_soon(peer, t, "enable released")
     assert card(page, "gamepad-enable") == "released"
 
-    # Enable again: moving; then the pad is unplugged mid-drive: zero.
+    # Enable again: moving (seen after the clear: the release's buffer still holds the stick's last
+    # motion); then the pad is unplugged mid-drive: zero.
+    peer.clear("/cmd_vel")
     pad(page, enable=True)
     peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] > 1, timeout=5.0)
     peer.clear("/cmd_vel")

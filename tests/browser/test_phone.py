@@ -53,7 +53,7 @@ def wide_pages(browser, base_url, pages):
             page.goto(base_url + path)
             for selector in shown:
                 page.wait_for_selector(selector, timeout=15000)
-            page.wait_for_timeout(1500)  # live rows and charts fill in
+            page.wait_for_timeout(800)  # live rows and charts fill in (each page waited above for its own)
             if overflow(page) > 0:
                 wide[path] = (overflow(page), page.evaluate(WIDE))
         return "\n".join(f"{path}: {px}px wider: {els}" for path, (px, els) in wide.items())
