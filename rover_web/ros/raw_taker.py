@@ -12,6 +12,11 @@ waiting on a ready subscription in one go; rclpy's own `wait_for_message` uses t
 The subscriptions live on a node in no executor, so nothing else ever takes their messages; they
 are created from any thread and destroyed by the taker thread only (between two waits), so a
 handle is never freed while a wait uses it.
+
+Given the app's own node (`node=`), a taker makes its subscriptions on that node's handle without
+registering them with the node, so the executor never waits on them and the graph shows no second
+node: the runtime takes its high-rate shared topics (/odom at 50-100 Hz) this way
+(RosRuntime.subscribe(share=True, raw=True)), off the executor's per-wake Python.
 """
 
 from __future__ import annotations
@@ -24,6 +29,7 @@ import rclpy
 from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.parameter import Parameter
+from rclpy.type_support import check_is_valid_msg_type
 
 from .typesupport import message_class
 
@@ -33,10 +39,27 @@ WAIT_NS = 1_000_000_000  # the thread looks at `closed` at least this often
 MAX_TAKE = 100  # messages taken from one subscription per wake, so none can starve the others
 
 
+class _Detached:
+    """A subscription on a node's handle that the node does not know, so no executor waits on it."""
+
+    def __init__(self, node, msg_type, topic: str, qos):
+        check_is_valid_msg_type(msg_type)  # imports the type support
+        with node.handle:
+            self.handle = _rclpy.Subscription(node.handle, msg_type, topic, qos.get_c_qos_profile())
+        self.msg_type = msg_type
+        self.topic_name = self.handle.get_topic_name()
+
+    def destroy(self) -> None:
+        self.handle.destroy_when_not_in_use()
+
+
 class RawTaker:
-    def __init__(self, runtime, suffix: str, *, namespace: str = ""):
+    def __init__(self, runtime, suffix: str, *, namespace: str = "", node=None):
+        """A node of its own, named after the runtime's with `suffix`; or, given `node`, subscriptions
+        on that node that its executor never sees."""
         self._context = runtime.context
-        self.node = rclpy.create_node(
+        self._own_node = node is None
+        self.node = node if node is not None else rclpy.create_node(
             f"{runtime.node.get_name()}_{suffix}", namespace=namespace or runtime.node.get_namespace(),
             context=self._context, start_parameter_services=False,
             parameter_overrides=[Parameter("start_type_description_service", value=False)])
@@ -52,13 +75,17 @@ class RawTaker:
         self._thread.start()
         runtime.on_stop(self.close)  # before the context goes
 
-    def subscribe(self, msg_type: str, topic: str, callback: Callable[[bytes, int], None], qos):
+    def subscribe(self, msg_type: str | type, topic: str, callback: Callable[[bytes, int], None], qos):
         """callback(data, received_ns) on the taker thread for each message of `topic`: its bytes as
         they came, and when the middleware received it (ns since the epoch; 0 if it does not say).
         Messages taken together in one wake keep their own reception times."""
-        subscription = self.node.create_subscription(
-            message_class(msg_type), topic, _never_called, qos, raw=True,
-            event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False))
+        cls = message_class(msg_type) if isinstance(msg_type, str) else msg_type
+        if self._own_node:
+            subscription = self.node.create_subscription(
+                cls, topic, _never_called, qos, raw=True,
+                event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False))
+        else:
+            subscription = _Detached(self.node, cls, topic, qos)
         with self._lock:
             self._taken[id(subscription)] = (subscription, callback)
             self._changed = True
@@ -83,7 +110,13 @@ class RawTaker:
         self._wake.trigger_guard_condition()
         self._thread.join(2.0)
         if not self._thread.is_alive():
-            self.node.destroy_node()
+            if self._own_node:
+                self.node.destroy_node()
+            else:  # the node is the runtime's, destroyed after this; these are ours
+                with self._lock:
+                    left, self._taken = list(self._taken.values()), {}
+                for subscription, _ in left:
+                    subscription.destroy()
             self._wake.destroy_when_not_in_use()
 
     # --- the taker thread ---
@@ -116,7 +149,10 @@ class RawTaker:
             retired, self._retired = self._retired, []
             taken = list(self._taken.values())
         for subscription, done in retired:  # in no wait now: this thread is the only one waiting
-            self.node.destroy_subscription(subscription)
+            if self._own_node:
+                self.node.destroy_subscription(subscription)
+            else:
+                subscription.destroy()
             done.set()
         wait_set = _rclpy.WaitSet(len(taken), 1, 0, 0, 0, 0, self._context.handle)
         return wait_set, taken

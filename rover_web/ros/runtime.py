@@ -23,6 +23,7 @@ from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import get_rmw_implementation_identifier
 
 from . import qos as qos_profiles
+from .raw_taker import RawTaker
 from .topic_stats import TopicStats
 from .typesupport import message_class, type_name
 
@@ -54,6 +55,7 @@ class RosRuntime:
         self._thread = threading.Thread(target=self._spin, name="ros-executor", daemon=True)
         self._stats: dict[str, TopicStats] = {}
         self._shared: dict[tuple, list[Callable[[Any], None]]] = {}
+        self._taker = None  # RawTaker for the shared raw subscriptions, made with the first
         self._stop_hooks: list[Callable[[], None]] = []
         self._stop_lock = threading.Lock()
         self._stopped = False
@@ -137,7 +139,10 @@ class RosRuntime:
         code that measures bandwidth or decodes only some messages. `share`: features that read the
         same topic (telemetry and the GPS heading both read /odom) get one subscription between
         them, with the same type, QoS and rawness, so each message is taken once, not once each;
-        such a subscription is never destroyed.
+        such a subscription is never destroyed. A shared raw subscription (the high-rate topics
+        the app reads at known offsets) is taken by a thread of its own, not the executor
+        (raw_taker.py: the executor's per-message Python was most of what /odom cost); its
+        callbacks must be thread-safe, and it returns None.
         """
         cls = message_class(msg_type) if isinstance(msg_type, str) else msg_type
         if share:
@@ -168,6 +173,11 @@ class RosRuntime:
                 self.callback_errors += 1
                 log.exception("callback for %s failed", topic)
 
+        if share and raw:
+            if self._taker is None:
+                self._taker = RawTaker(self, "shared", node=self.node)
+            self._taker.subscribe(cls, topic, lambda data, _received_ns: guarded(data), self._qos(qos))
+            return None
         return self.node.create_subscription(
             cls, topic, guarded, self._qos(qos), raw=raw,
             event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False))

@@ -97,12 +97,16 @@ def test_two_apps_in_one_process_do_not_share_ros_state(app_factory, ros_peer):
 
 
 def test_telemetry_and_the_gps_heading_share_one_odom_subscription(live_server, ros_peer, sse_client):
-    """Both read /odom by default: one subscription takes each message once and serves both."""
+    """Both read /odom by default: one subscription takes each message once and serves both, and
+    it is taken off the executor (its thread of its own), on the app's one node."""
     node = live_server.rover.runtime.node
-    assert [s.topic_name for s in node.subscriptions].count("/odom") == 1
+    assert "/odom" not in [s.topic_name for s in node.subscriptions]
     peer = ros_peer()
     peer.advertise("/odom", ODOM)
     peer.wait_match("/odom")
+    assert peer.graph(["/odom"])["subscribers"]["/odom"] == 1  # the whole graph: our one, and no other
+    assert [n for n, _ns in node.get_subscriber_names_and_types_by_node(node.get_name(), "/")
+            if n == "/odom"] == ["/odom"]
     stream = sse_client(live_server.url + "/api/events?channels=odom,heading")
     warm_up_until_received(peer, live_server.rover)
     facing_north = odom(x=4.0)  # yaw +90 degrees (ENU): a compass bearing of 0
