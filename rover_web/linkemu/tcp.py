@@ -81,6 +81,7 @@ class TcpRelay:
         self.accepted = 0
         self._server: asyncio.Server | None = None
         self._tasks: set[asyncio.Task] = set()
+        self._stopping = False
 
     async def start(self) -> tuple[str, int]:
         sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
@@ -92,13 +93,17 @@ class TcpRelay:
         return sock.getsockname()[:2]
 
     async def stop(self) -> None:
+        self._stopping = True
         if self._server is not None:
             self._server.close()
         for conn in list(self.connections):
             conn.abort()
-        for task in list(self._tasks):
-            task.cancel()
-        await asyncio.gather(*self._tasks, return_exceptions=True)
+        # A connection accepted just before the close has its handler task scheduled but not yet
+        # started (so not in _tasks): it starts during the wait below, sees _stopping and aborts.
+        while self._tasks:
+            for task in list(self._tasks):
+                task.cancel()
+            await asyncio.gather(*self._tasks, return_exceptions=True)
         if self._server is not None:
             await self._server.wait_closed()
         # An aborted transport closes its socket in a callback on the next turns of the loop: give
@@ -112,6 +117,9 @@ class TcpRelay:
             conn.abort()
 
     async def _accepted(self, client_r: asyncio.StreamReader, client_w: asyncio.StreamWriter) -> None:
+        if self._stopping:
+            client_w.transport.abort()
+            return
         task = asyncio.current_task()
         self._tasks.add(task)
         self.accepted += 1

@@ -49,7 +49,7 @@ def test_dragging_in_pose_mode_publishes_the_pose_drawn(live_server, page, pose_
     left, top = canvas_origin(page)
     page.click("#livemap-pose-mode")
     assert page.locator("#livemap-pose-mode").get_attribute("aria-pressed") == "true"
-    assert state(page)["mode"] == "pose"
+    page.wait_for_function("window.liveMapState.mode === 'pose'")  # the state is published with the next frame
     # Press at (12, 10.5) m and drag straight down the screen: the robot faces -y (-90 degrees).
     x, y = expected_screen(s, 12.0, 10.5)
     page.mouse.move(left + x, top + y)
@@ -77,7 +77,7 @@ def test_dragging_in_pose_mode_publishes_the_pose_drawn(live_server, page, pose_
     pose_listener.clear("/initialpose")
     page.locator("#livemap-canvas").focus()
     page.keyboard.press("p")
-    assert state(page)["mode"] == "pose"
+    page.wait_for_function("window.liveMapState.mode === 'pose'")
     x, y = expected_screen(state(page), 25.0, 6.0)
     page.mouse.click(left + x, top + y)
     pose_answered(page, after=answer)

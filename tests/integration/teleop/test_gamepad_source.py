@@ -1,5 +1,7 @@
 """Drive frames with "source": "gamepad" over the real socket: a separate rclpy subscriber sees them,
-the `teleop` channel and the log name the source, and the server's rules apply as to the joystick."""
+the `teleop` channel and the log name the source, and the server's rules apply as to the joystick.
+Its waits are generous (3 s): it checks which frames drive, not how fast a stop lands, which the
+e-stop and deadman tests bound."""
 
 import logging
 
@@ -23,13 +25,13 @@ def test_gamepad_frames_drive_are_recorded_and_obey_the_estop(rig, sse_client, c
     pad = TeleopClient(server.url, name="alice")
     with caplog.at_level(logging.INFO, logger="rover_web.teleop.control"):
         pad.drive(0.5, -0.25, source="gamepad")
-        peer.wait_for("/cmd_vel", lambda m: (m["linear"]["x"], m["angular"]["z"]) == (2.5, -0.5), timeout=2.0)
+        peer.wait_for("/cmd_vel", lambda m: (m["linear"]["x"], m["angular"]["z"]) == (2.5, -0.5), timeout=3.0)
         stream.wait_for("teleop", lambda s: s["source"] == "gamepad" and s["linear_mps"] == 2.5)
     assert "teleop: alice drives with the gamepad" in [r.getMessage() for r in caplog.records]
 
     # A value outside [-1, 1] is refused as for the joystick, and the robot is at zero.
     pad.send({"linear": 1.5, "angular": 0, "epoch": pad.epoch, "source": "gamepad"})
-    peer.wait_for("/cmd_vel", is_zero, timeout=1.0)
+    peer.wait_for("/cmd_vel", is_zero, timeout=3.0)
     assert pad.wait_errors(1)[0]["error"] == "out_of_range"
     # An unknown source is refused too.
     pad.send({"linear": 0.5, "angular": 0, "epoch": pad.epoch, "source": "joypad"})
@@ -37,7 +39,7 @@ def test_gamepad_frames_drive_are_recorded_and_obey_the_estop(rig, sse_client, c
 
     # Another socket's gamepad is view-only while alice holds control.
     pad.drive(0.2, 0.0, source="gamepad")
-    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == 1.0, timeout=2.0)
+    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == 1.0, timeout=3.0)
     other = TeleopClient(server.url, name="bob")
     other.drive(-1.0, 0.0, source="gamepad")
     assert other.wait_for(lambda m: m["type"] == "error")["error"] == "not_in_control"
@@ -46,7 +48,7 @@ def test_gamepad_frames_drive_are_recorded_and_obey_the_estop(rig, sse_client, c
     peer.clear("/cmd_vel")
     pad.send({"estop": True})
     pad.wait_for(lambda m: m["type"] == "state" and m["reason"] == "estop")
-    peer.wait_for("/cmd_vel", is_zero, timeout=1.0)
+    peer.wait_for("/cmd_vel", is_zero, timeout=3.0)
     pad.drive(0.2, 0.0, source="gamepad")
     assert pad.wait_for(lambda m: m["type"] == "error" and m["error"] == "estop_engaged")["status"] == 409
     server.rover.feature(EStopService).release("test")
@@ -56,6 +58,6 @@ def test_gamepad_frames_drive_are_recorded_and_obey_the_estop(rig, sse_client, c
     assert all(lin == 0.0 for _, lin, _ in twists(peer))
     pad.drive(0.0, 0.0, source="gamepad")
     pad.drive(0.2, 0.0, source="gamepad")
-    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == 1.0, timeout=2.0)
+    peer.wait_for("/cmd_vel", lambda m: m["linear"]["x"] == 1.0, timeout=3.0)
     pad.send({"stop": True})
-    peer.wait_for("/cmd_vel", is_zero, timeout=1.0)
+    peer.wait_for("/cmd_vel", is_zero, timeout=3.0)
