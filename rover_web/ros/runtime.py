@@ -55,7 +55,7 @@ class RosRuntime:
         self._thread = threading.Thread(target=self._spin, name="ros-executor", daemon=True)
         self._stats: dict[str, TopicStats] = {}
         self._shared: dict[tuple, list[Callable[[Any], None]]] = {}
-        self._taker = None  # RawTaker for the shared raw subscriptions, made with the first
+        self._taker = None  # RawTaker for the shared raw subscriptions, made with the first of them
         self._stop_hooks: list[Callable[[], None]] = []
         self._stop_lock = threading.Lock()
         self._stopped = False
