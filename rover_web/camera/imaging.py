@@ -24,9 +24,15 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from PIL import Image, ImageDraw, ImageFont
+
+if TYPE_CHECKING:
+    from PIL import Image, ImageFont
+
+# Pillow is imported by the functions that draw or code pictures: a server whose camera nobody
+# watches never loads it (issue 32: idle RSS). numpy is loaded by ROS's message classes anyway.
 
 # Encoding name -> (bytes per pixel, output: "RGB" or "L").
 ENCODINGS: dict[str, tuple[int, str]] = {
@@ -157,6 +163,8 @@ def output_size(src_width: int, src_height: int, width: int | None, height: int 
 
 def _encode_picture(picture: Image.Image, quality: int, width: int | None, height: int | None, stamp: float,
                     started: float, max_pixels: int | None) -> Jpeg:
+    from PIL import Image
+
     size = output_size(picture.width, picture.height, width, height, max_pixels)
     if size != picture.size:
         picture = picture.resize(size, Image.Resampling.BILINEAR)
@@ -168,6 +176,8 @@ def _encode_picture(picture: Image.Image, quality: int, width: int | None, heigh
 def encode_raw(image: RawImage, quality: int, width: int | None = None, height: int | None = None,
                max_pixels: int | None = None) -> Jpeg:
     """A sensor_msgs/Image as JPEG; FrameError for encodings or layouts that cannot be shown."""
+    from PIL import Image
+
     started = time.perf_counter()
     picture = Image.fromarray(np.ascontiguousarray(image_to_array(image)))
     return _encode_picture(picture, quality, width, height, image.stamp, started, max_pixels)
@@ -192,6 +202,8 @@ def decode_compressed(frame: CompressedFrame, data: bytes | None = None,
     """A CompressedImage's picture, RGB or L (16-bit and float stretched to 8 bits): FrameError for
     what cannot be shown. `output_size_of(w, h)` lets libjpeg scale by 1/2, 1/4 or 1/8 while
     decoding when the output will be smaller."""
+    from PIL import Image
+
     check_compressed_format(frame)
     data = bytes(frame.data) if data is None else data
     try:
@@ -234,6 +246,8 @@ def encode_compressed(frame: CompressedFrame, quality: int, width: int | None = 
 
 def _jpeg_size(data: bytes) -> tuple[int, int]:
     """Width and height from the JPEG's start-of-frame header, without decoding it."""
+    from PIL import Image
+
     try:
         with Image.open(io.BytesIO(data), formats=("JPEG",)) as picture:
             return picture.size
@@ -245,6 +259,8 @@ _FONT_CACHE: dict[int, ImageFont.ImageFont] = {}
 
 
 def font(size: int):
+    from PIL import ImageFont
+
     if size not in _FONT_CACHE:
         try:
             _FONT_CACHE[size] = ImageFont.load_default(size)
@@ -256,6 +272,8 @@ def font(size: int):
 def error_frame(message: str, code: str, width: int | None = None, height: int | None = None,
                 stamp: float = 0.0, max_pixels: int | None = None) -> Jpeg:
     """A dark JPEG with the reason written on it, for a stream that has already started."""
+    from PIL import Image, ImageDraw
+
     size = output_size(640, 360, width, height, max_pixels)
     picture = Image.new("RGB", size, (40, 12, 12))
     draw = ImageDraw.Draw(picture)

@@ -24,13 +24,15 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
-
-import shapely
-from shapely.geometry import LineString, MultiPolygon, Point, Polygon
-from shapely.ops import unary_union
+from typing import TYPE_CHECKING, Any
 
 from rover_web.web.validate import InvalidInput
+
+if TYPE_CHECKING:
+    from shapely.geometry import MultiPolygon, Polygon
+
+# shapely (with numpy's and GEOS's libraries, ~3.5 MB) is imported where a fence is built or
+# checked, not here: a robot with no fence never loads it (issue 32: idle RSS).
 
 KINDS = ("keep_in", "keep_out")
 MAX_NAME_CHARS = 80
@@ -63,6 +65,11 @@ class Fence:
         self.areas = tuple(areas)
         self.keep_out = tuple(a for a in self.areas if a.kind == "keep_out")
         keep_in = [a.geometry for a in self.areas if a.kind == "keep_in"]
+        self.keep_in = None
+        if not self.areas:
+            return
+        import shapely
+        from shapely.ops import unary_union
         self.keep_in = unary_union(keep_in) if keep_in else None
         for geometry in [self.keep_in, *(a.geometry for a in self.keep_out)]:
             if geometry is not None:
@@ -79,6 +86,9 @@ class Fence:
 
     def refusal(self, lng: float, lat: float) -> OutsideGeofence | None:
         """Why the point is not allowed, or None."""
+        if self.empty:
+            return None
+        from shapely.geometry import Point
         point = Point(lng, lat)
         if self.keep_in is not None and not self.keep_in.covers(point):
             return OutsideGeofence(f"({lng:.7f}, {lat:.7f}) is outside every keep-in area of the geofence",
@@ -102,6 +112,7 @@ class Fence:
         """Every waypoint, then every leg between consecutive ones; OutsideGeofence at the first fault."""
         if self.empty:
             return
+        from shapely.geometry import LineString
         for i, (lng, lat) in enumerate(points):
             refused = self.refusal(lng, lat)
             if refused is not None:
@@ -138,7 +149,7 @@ def _coordinates(geometry) -> list:
     def polygon(p):
         return [ring(p.exterior), *(ring(h) for h in p.interiors)]
 
-    if isinstance(geometry, MultiPolygon):
+    if geometry.geom_type == "MultiPolygon":
         return [polygon(p) for p in geometry.geoms]
     return polygon(geometry)
 
@@ -186,6 +197,9 @@ def _area(i: int, feature: Any, counter: _VertexCounter) -> Area:
                            "characters", "bad_geojson")
     if name:
         where = f"{where} ({name!r})"
+    import shapely
+    from shapely.geometry import MultiPolygon
+
     geometry = feature.get("geometry")
     gtype = geometry.get("type") if isinstance(geometry, dict) else None
     coordinates = geometry.get("coordinates") if isinstance(geometry, dict) else None
@@ -214,6 +228,8 @@ def _area(i: int, feature: Any, counter: _VertexCounter) -> Area:
 def _polygon(rings: Any, where: str, counter: _VertexCounter) -> Polygon:
     if not isinstance(rings, list) or not rings:
         raise InvalidInput(f"{where} must be a list of linear rings (the outline, then any holes)", "bad_geojson")
+    from shapely.geometry import Polygon
+
     parsed = [_ring(r, f"{where}[{k}]", counter) for k, r in enumerate(rings)]
     return Polygon(parsed[0], parsed[1:])
 

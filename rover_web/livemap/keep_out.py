@@ -11,12 +11,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
-
-import shapely
-from shapely.geometry import Point, Polygon
+from typing import TYPE_CHECKING, Any
 
 from rover_web.geofence import OutsideGeofence
+
+if TYPE_CHECKING:
+    from shapely.geometry import Polygon
+
+# shapely is imported where an area is built or checked: a robot with no floorplans (or none with
+# keep-out areas) never loads it (issue 32: idle RSS).
 
 MAX_POINTS = 1000
 
@@ -55,6 +58,9 @@ def _area(item: Any, where: str) -> KeepOutArea:
         points.append((float(p[0]), float(p[1])))
     if points[0] == points[-1]:
         points.pop()
+    import shapely
+    from shapely.geometry import Polygon
+
     polygon = Polygon(points)
     reason = shapely.is_valid_reason(polygon)
     if len(points) < 3 or reason != "Valid Geometry" or polygon.area <= 0:
@@ -65,6 +71,10 @@ def _area(item: Any, where: str) -> KeepOutArea:
 
 def check_goal(areas: tuple[KeepOutArea, ...], map_name: str, x: float, y: float) -> None:
     """OutsideGeofence when (x, y) lies in (or on the edge of) a keep-out area."""
+    if not areas:
+        return
+    from shapely.geometry import Point
+
     point = Point(x, y)
     for i, area in enumerate(areas):
         if area.polygon.intersects(point):

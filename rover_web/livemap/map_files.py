@@ -31,7 +31,6 @@ from pathlib import Path
 from typing import Any
 
 import yaml
-from PIL import Image, ImageOps
 
 from rover_web.config import ROOT, ConfigError
 
@@ -100,6 +99,8 @@ class MapDefinition:
 
 
 def make_thumbnail(png: bytes, side_px: int = THUMBNAIL_SIDE_PX) -> bytes:
+    from PIL import Image  # here and below: a robot with no floorplans never loads Pillow (issue 32)
+
     with Image.open(io.BytesIO(png), formats=("PNG",)) as image:
         image = image.convert("RGBA" if "A" in image.getbands() else "RGB")
         image.thumbnail((side_px, side_px), Image.Resampling.BOX)  # BOX keeps thin walls visible as grey
@@ -113,6 +114,8 @@ def _display_png(path: Path, params: dict) -> bytes:
     negate = bool(params.get("negate", 0))
     if path.suffix.lower() == ".png" and not negate:
         return path.read_bytes()
+    from PIL import Image, ImageOps
+
     with Image.open(path, formats=MAP_IMAGE_FORMATS) as image:
         image.load()
         if negate:
@@ -219,6 +222,8 @@ def _image_size(path: Path, src: _Source, key: str) -> tuple[int, int]:
         raise src.error(key, f"{path.name}: expected a .png or .pgm image")
     if not path.is_file():
         raise src.error(key, f"{path} not found")
+    from PIL import Image
+
     try:
         with Image.open(path, formats=MAP_IMAGE_FORMATS) as image:
             size = image.size

@@ -12,7 +12,6 @@ from __future__ import annotations
 import io
 
 import numpy as np
-from PIL import Image
 
 FREE_MAX = 25
 OCCUPIED_MIN = 65
@@ -34,6 +33,8 @@ def grid_to_image(data: np.ndarray, width: int, height: int) -> np.ndarray:
 
 
 def image_to_png(image: np.ndarray) -> bytes:
+    from PIL import Image  # when a map is first drawn, not at start (issue 32: idle RSS)
+
     out = io.BytesIO()
     Image.fromarray(image).save(out, "PNG", compress_level=3)
     return out.getvalue()

@@ -30,12 +30,10 @@ from pathlib import Path
 from mcap.data_stream import ReadDataStream
 from mcap.exceptions import McapError
 from mcap.opcode import Opcode
-from mcap.reader import SeekingReader
 from mcap.records import Channel, Chunk, Message, Schema
-from mcap.stream_reader import breakup_chunk
 from mcap_ros2.decoder import DecoderFactory
 
-from .reading import CUT_OR_DAMAGED, MAGIC, NotARecording, read_messages
+from .reading import MAGIC, NotARecording, cut_or_damaged, read_messages
 
 CACHED_FILES = 8
 _RECORD_HEAD = struct.Struct("<BQ")  # opcode, content length
@@ -172,10 +170,12 @@ class FileIndex:
 
     @staticmethod
     def _read_chunk(f, chunk: ChunkRef) -> list:
+        from mcap.stream_reader import breakup_chunk  # with lz4 and zstandard: see reading.py
+
         f.seek(chunk.offset + _RECORD_HEAD.size)
         try:
             return breakup_chunk(Chunk.read(ReadDataStream(f)), validate_crc=True)
-        except CUT_OR_DAMAGED:
+        except cut_or_damaged():
             return []  # the chunk the index pass read is damaged now: nothing from it
 
 
@@ -197,8 +197,9 @@ def from_summary(path: Path) -> FileIndex | None:
             if f.read(len(MAGIC)) != MAGIC or not _ends_with_magic(f):
                 return None
             f.seek(0)
+            from mcap.reader import SeekingReader
             summary = SeekingReader(f).get_summary()
-    except (OSError, *CUT_OR_DAMAGED):
+    except (OSError, *cut_or_damaged()):
         return None
     if summary is None or not summary.chunk_indexes or summary.statistics is None \
             or not all(ci.message_index_offsets for ci in summary.chunk_indexes):
@@ -232,7 +233,7 @@ def walk(path: Path, strict: bool = False) -> FileIndex:
             index = FileIndex(path, complete=False)
             try:
                 _walk_records(f, size, index)
-            except CUT_OR_DAMAGED as exc:
+            except cut_or_damaged() as exc:
                 if strict:
                     raise Refused("corrupt", f"the file is damaged at byte {f.tell()} "
                                              f"({type(exc).__name__}: {str(exc)[:120]})") from None
@@ -255,6 +256,8 @@ def _ends_with_magic(f) -> bool:
 
 
 def _walk_records(f, size: int, index: FileIndex) -> None:
+    from mcap.stream_reader import breakup_chunk
+
     while True:
         head = f.read(_RECORD_HEAD.size)
         if len(head) < _RECORD_HEAD.size:

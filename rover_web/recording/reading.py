@@ -8,22 +8,28 @@ chunk at least every recorder.FLUSH_S), so reading until that point is reading a
 
 from __future__ import annotations
 
+import functools
 import struct
 import zlib
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-import zstandard
 from mcap.exceptions import EndOfFile, InvalidMagic, McapError
 from mcap.records import Channel, Footer, Message, Schema
-from mcap.stream_reader import StreamReader
 
 MAGIC = b"\x89MCAP0\r\n"
-# What the stream reader raises where the bytes stop or stop making sense (CRCValidationError is a ValueError;
-# the lz4 package says a damaged or cut frame with a RuntimeError).
-CUT_OR_DAMAGED = (EndOfFile, InvalidMagic, McapError, struct.error, zlib.error, zstandard.ZstdError, ValueError,
-                  RuntimeError)
+
+
+# mcap's stream reader brings lz4 and zstandard (1.5 MB): they load when a recording is first read
+# or written, not at start (issue 32: idle RSS); hence a function, not a module-level tuple.
+@functools.cache
+def cut_or_damaged() -> tuple[type[BaseException], ...]:
+    """What the stream reader raises where the bytes stop or stop making sense (CRCValidationError
+    is a ValueError; the lz4 package says a damaged or cut frame with a RuntimeError)."""
+    import zstandard
+    return (EndOfFile, InvalidMagic, McapError, struct.error, zlib.error, zstandard.ZstdError, ValueError,
+            RuntimeError)
 
 
 class NotARecording(ValueError):
@@ -40,6 +46,8 @@ def read_messages(path: Path, outcome: Outcome | None = None) -> Iterator[tuple[
     """Every message in file order, with its channel and schema; stops quietly at a cut end
     (outcome.complete says whether the footer was there). NotARecording for anything that is
     not MCAP; a damaged chunk in the middle ends the reading like a cut."""
+    from mcap.stream_reader import StreamReader
+
     outcome = outcome if outcome is not None else Outcome()
     try:
         with open(path, "rb") as f:
@@ -62,7 +70,7 @@ def read_messages(path: Path, outcome: Outcome | None = None) -> Iterator[tuple[
                         yield schemas.get(channel.schema_id), channel, record
                     elif isinstance(record, Footer):
                         outcome.complete = True
-            except CUT_OR_DAMAGED as exc:
+            except cut_or_damaged() as exc:
                 if outcome.messages == 0 and not channels:
                     raise NotARecording(f"{path} is damaged before its first message ({type(exc).__name__})") \
                         from None

@@ -24,8 +24,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from mcap.writer import CompressionType, Writer
-
 from .schema import schema_text
 
 log = logging.getLogger(__name__)
@@ -64,6 +62,8 @@ class Recorder:
         self.error: str | None = None
         self.started_ns = time.time_ns()
         self.ended_ns: int | None = None
+        from mcap.writer import CompressionType, Writer  # lz4 and zstandard load with it (reading.py)
+
         self._stream = open(path, "xb")  # noqa: SIM115 - owned by the writer thread, closed at its end
         self._writer = Writer(self._stream, chunk_size=CHUNK_BYTES, compression=CompressionType.LZ4)
         # profile "ros2" and schema names "pkg/msg/Type", as rosbag2's MCAP plugin writes them.

@@ -5,7 +5,9 @@ thread, like the e-stop's GoalCanceller: the clients made for these calls never 
 executor's wait set, so teleop and the event paths do not pay for them. A request thread sends
 a call and waits on its future with a timeout; it never spins.
 
-Results are plain values (dicts, lists); failures are the exceptions below.
+Results are plain values (dicts, lists); failures are the exceptions below. rclpy.action is
+imported by the calls that use it, and the node made at the first call (ros_admin/service.py):
+a server nobody opens /ros on never loads either (issue 32: idle RSS).
 """
 
 from __future__ import annotations
@@ -19,8 +21,6 @@ from typing import Any
 from rcl_interfaces.msg import Parameter as ParameterMsg
 from rcl_interfaces.msg import ParameterType, ParameterValue
 from rcl_interfaces.srv import DescribeParameters, GetParameters, ListParameters, SetParameters
-from rclpy.action import ActionClient
-from rclpy.action.graph import get_action_client_names_and_types_by_node, get_action_server_names_and_types_by_node
 
 from .convert import message_to_dict
 from .side_node import SideNode
@@ -92,6 +92,10 @@ class AdminNode:
     # --- the graph ---
 
     def nodes(self) -> list[dict]:
+        from rclpy.action.graph import (
+            get_action_client_names_and_types_by_node,
+            get_action_server_names_and_types_by_node,
+        )
         node = self._node
         out = []
         for name, namespace in sorted(node.get_node_names_and_namespaces(), key=lambda p: (p[1], p[0])):
@@ -132,6 +136,7 @@ class AdminNode:
 
     def serving_nodes(self, name: str, action: bool = False) -> list[str]:
         """The nodes that serve the service (or action) `name`, by full name."""
+        from rclpy.action.graph import get_action_server_names_and_types_by_node
         node = self._node
         out = []
         for n, namespace in node.get_node_names_and_namespaces():
@@ -154,6 +159,7 @@ class AdminNode:
                 self._clients.move_to_end(key)
                 return client
             if kind == "action":
+                from rclpy.action import ActionClient
                 client = ActionClient(self._node, cls, name)
             else:
                 client = self._node.create_client(cls, name)

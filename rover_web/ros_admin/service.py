@@ -13,6 +13,7 @@ always, parameter sets on ROVER_WEB_ROS_ADMIN_SAFETY_NODES), and no known naviga
 from __future__ import annotations
 
 import logging
+import threading
 from typing import Any
 
 from rover_web.core.state import Rover
@@ -72,10 +73,21 @@ class RosAdmin:
         self.mode = config["ROVER_WEB_ROS_ADMIN"]
         self.rules = rules_from(config)
         self.safety_nodes = tuple(config["ROVER_WEB_ROS_ADMIN_SAFETY_NODES"])
-        # Off: no node of its own at all, so nothing here can reach the graph.
-        self.node = AdminNode(rover.runtime) if self.mode != "off" else None
+        # Made at the first call, not at start (a node, its executor thread and rclpy.action:
+        # most servers never get a call from /ros). Off: never, so nothing here reaches the graph.
+        self._node: AdminNode | None = None
+        self._node_lock = threading.Lock()
         self.oplog = oplog or OperatorLog(rover.db, LOG_KEEP, audit=rover.audit)
         self.goals = GoalBook()
+
+    @property
+    def node(self) -> AdminNode:
+        with self._node_lock:
+            if self._node is None:
+                if self.mode == "off" or not self.rover.runtime.running:
+                    raise AdminRefused(503, "ros_admin_unavailable", "ROS admin is off or the server is stopping")
+                self._node = AdminNode(self.rover.runtime)
+            return self._node
 
     def record(self, control: str, label: str, value: Any, result: str, reason: str, client: str) -> None:
         try:

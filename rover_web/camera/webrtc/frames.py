@@ -13,7 +13,6 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from PIL import Image
 
 from rover_web.camera import imaging
 from rover_web.camera.imaging import CompressedFrame, RawImage
@@ -39,6 +38,7 @@ def _resized(pixels: np.ndarray, width: int | None, height: int | None, max_pixe
     size = (max(2, size[0] // 2 * 2), max(2, size[1] // 2 * 2))  # 4:2:0 video wants even sides
     if size == (src_w, src_h):
         return np.ascontiguousarray(pixels)
+    from PIL import Image  # as imaging.py: only when a picture is made
     return np.asarray(Image.fromarray(np.ascontiguousarray(pixels)).resize(size, Image.Resampling.BILINEAR))
 
 
@@ -57,6 +57,8 @@ def to_picture(frame: RawImage | CompressedFrame, width: int | None = None, heig
 def error_picture(message: str, code: str, width: int | None = None, height: int | None = None,
                   max_pixels: int | None = None) -> Picture:
     """The same dark frame with the reason written on it that an MJPEG viewer sees."""
+    from PIL import Image
+
     jpeg = imaging.error_frame(message, code, width, height, max_pixels=max_pixels)
     pixels = _resized(np.asarray(Image.open(io.BytesIO(jpeg.data)).convert("RGB")), None, None, None)
     return Picture(pixels, pixels.shape[1], pixels.shape[0], error=message, error_code=code)
