@@ -26,7 +26,6 @@ import threading
 from collections.abc import Callable
 
 import rclpy
-from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.parameter import Parameter
 from rclpy.type_support import check_is_valid_msg_type
@@ -80,12 +79,9 @@ class RawTaker:
         they came, and when the middleware received it (ns since the epoch; 0 if it does not say).
         Messages taken together in one wake keep their own reception times."""
         cls = message_class(msg_type) if isinstance(msg_type, str) else msg_type
-        if self._own_node:
-            subscription = self.node.create_subscription(
-                cls, topic, _never_called, qos, raw=True,
-                event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False))
-        else:
-            subscription = _Detached(self.node, cls, topic, qos)
+        # Detached on either node: the taker alone owns and destroys it (its own node is in no
+        # executor anyway, and the runtime's must not see it).
+        subscription = _Detached(self.node, cls, topic, qos)
         with self._lock:
             self._taken[id(subscription)] = (subscription, callback)
             self._changed = True
@@ -110,13 +106,12 @@ class RawTaker:
         self._wake.trigger_guard_condition()
         self._thread.join(2.0)
         if not self._thread.is_alive():
+            with self._lock:
+                left, self._taken = list(self._taken.values()), {}
+            for subscription, _ in left:
+                subscription.destroy()
             if self._own_node:
                 self.node.destroy_node()
-            else:  # the node is the runtime's, destroyed after this; these are ours
-                with self._lock:
-                    left, self._taken = list(self._taken.values()), {}
-                for subscription, _ in left:
-                    subscription.destroy()
             self._wake.destroy_when_not_in_use()
 
     # --- the taker thread ---
@@ -149,10 +144,7 @@ class RawTaker:
             retired, self._retired = self._retired, []
             taken = list(self._taken.values())
         for subscription, done in retired:  # in no wait now: this thread is the only one waiting
-            if self._own_node:
-                self.node.destroy_subscription(subscription)
-            else:
-                subscription.destroy()
+            subscription.destroy()
             done.set()
         wait_set = _rclpy.WaitSet(len(taken), 1, 0, 0, 0, 0, self._context.handle)
         return wait_set, taken
@@ -178,7 +170,3 @@ class RawTaker:
             retired, self._retired = self._retired, []
         for _subscription, done in retired:
             done.set()
-
-
-def _never_called(_message) -> None:  # the node is in no executor
-    pass

@@ -7,8 +7,10 @@ Commands (stdin):  {"op": "sub"|"pub", "topic", "type", "qos"}  {"op": "send", "
                    (through the node's own logger, so the lines reach /rosout as any node's do)
                    {"op": "graph", "count": [topics]} -> ack with nodes, topics, pub/sub counts
 Events (stdout):   {"event": "ready"}  {"event": "ack", "op"}  {"event": "error", "message"}
-                   {"event": "msg", "topic", "t": <CLOCK_MONOTONIC seconds>, "msg": {...}}
+                   {"event": "msg", "topic", "t": <CLOCK_MONOTONIC seconds>, "sent": <s>, "msg": {...}}
 CLOCK_MONOTONIC is system-wide on Linux, so "t" compares directly with the test's time.monotonic().
+"sent" is the middleware's source timestamp (wall clock, s): when the publisher wrote it, which a
+loaded machine does not move the way it moves when this process got to take it.
 """
 
 import json
@@ -50,6 +52,14 @@ def emit(**event):
         sys.stdout.flush()
 
 
+def _callback(emit, topic: str, max_items: int):
+    # Two parameters and no defaults: rclpy passes the message info only to a callback that way.
+    def callback(msg, info):
+        emit(event="msg", topic=topic, t=time.monotonic(), sent=info["source_timestamp"] / 1e9,
+             msg=message_to_dict(msg, max_items=max_items))
+    return callback
+
+
 def main():
     context = Context()
     rclpy.init(context=context, signal_handler_options=SignalHandlerOptions.NO)
@@ -80,12 +90,8 @@ def main():
 
                 max_items = cmd.get("max_items", 64)
 
-                # Bound now: `cmd` is the next command by the time a message arrives.
-                def callback(msg, topic=topic, max_items=max_items):
-                    t = time.monotonic()
-                    emit(event="msg", topic=topic, t=t, msg=message_to_dict(msg, max_items=max_items))
-
-                subs[topic] = node.create_subscription(message_class(cmd["type"]), topic, callback,
+                subs[topic] = node.create_subscription(message_class(cmd["type"]), topic,
+                                                       _callback(emit, topic, max_items),
                                                        profile(cmd.get("qos", "default")))
             elif op == "pub":
                 pubs[cmd["topic"]] = (cmd["type"], node.create_publisher(
