@@ -27,6 +27,7 @@ import time
 from typing import Any
 
 from .bitrate import EncoderBitrate
+from .silence import Silence
 
 # A resent packet older than this arrives after the browser's jitter buffer has given its frame
 # up (libwebrtc: a few NACK rounds); the radio's deep buffer alone holds about a second.
@@ -63,9 +64,11 @@ def tap_rtcp(session: Any, clock=time.monotonic) -> None:
     handle = sender._handle_rtcp_packet  # called per RTCP packet by the DTLS transport's router
     last_keyframe = -float("inf")
     steps = EncoderBitrate(vpx.DEFAULT_BITRATE, clock=clock)  # where aiortc's encoder starts
+    quiet = session.silence = Silence(clock)
 
     async def _handle(packet) -> None:
         nonlocal last_keyframe
+        quiet.heard()
         if isinstance(packet, RtcpPsfbPacket) and packet.fmt == RTCP_PSFB_APP:
             try:
                 bitrate, ssrcs = unpack_remb_fci(packet.fci)
@@ -94,3 +97,12 @@ def tap_rtcp(session: Any, clock=time.monotonic) -> None:
         await handle(packet)
 
     sender._handle_rtcp_packet = _handle
+    encode_next = sender._next_encoded_frame  # called on the loop for each frame the sender sends
+
+    async def _next_encoded_frame(codec):
+        if quiet.send():
+            return await encode_next(codec)
+        await session.track.recv()  # taken at the viewer's pace, so the frame after the silence is fresh
+        return None  # aiortc's sender sends nothing for it
+
+    sender._next_encoded_frame = _next_encoded_frame

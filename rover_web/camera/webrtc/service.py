@@ -87,6 +87,7 @@ class WhepSession:
     link_share: float = 1.0  # of that estimate, what the video may use (ROVER_WEB_WEBRTC_LINK_SHARE)
     loss_keyframes: int = 0  # keyframes sent instead of resending what could not help (feedback.py)
     encoder_restarts: int = 0  # bitrate changes aiortc made a new encoder (and so a keyframe) for
+    silence: Any = None  # silence.Silence: frames held while the browser sends no feedback
     revocation: Any = None  # its credential's registration (auth/revocation.py), cancelled when it ends
 
     @property
@@ -116,6 +117,7 @@ class WhepSession:
                 "height": out.height if out else None, "fps": out.fps if out else None,
                 "target_bps": self.encoder_bitrate(), "remb_bps": self.remb_bps,
                 "loss_keyframes": self.loss_keyframes, "encoder_restarts": self.encoder_restarts,
+                "frames_held": self.silence.held if self.silence else 0,
                 "teleop": self.teleop is not None and not self.teleop.closed,
                 "source_hz": self.producer.arrivals.snapshot(stale_after_s=2.0)["rate_hz"] if self.producer else None,
                 "age_s": round(time.monotonic() - self.created, 1)}

@@ -9,12 +9,14 @@ from aiortc.rtp import (
     RTCP_RTPFB_NACK,
     RTP_HISTORY_SIZE,
     RtcpPsfbPacket,
+    RtcpRrPacket,
     RtcpRtpfbPacket,
     RtpPacket,
     pack_remb_fci,
 )
 
 from rover_web.camera.webrtc import feedback
+from rover_web.camera.webrtc.silence import PROBE_S, SILENCE_S
 
 SSRC = 1234
 NOW_ABS = 5 << 18  # abs-send-time: 5 s
@@ -28,6 +30,11 @@ class Sender:
         self._RTCRtpSender__rtp_history = {}
         self.handled = []
         self.keyframes = 0
+        self.encoded = 0
+
+    async def _next_encoded_frame(self, codec):
+        self.encoded += 1
+        return f"frame {self.encoded}"
 
     async def _handle_rtcp_packet(self, packet):
         self.handled.append(packet)
@@ -41,6 +48,14 @@ class Sender:
         self._RTCRtpSender__rtp_history[seq % RTP_HISTORY_SIZE] = packet
 
 
+class Track:
+    def __init__(self):
+        self.taken = 0
+
+    async def recv(self):
+        self.taken += 1
+
+
 class Clock:
     t = 100.0
 
@@ -52,8 +67,8 @@ class Clock:
 def rig(monkeypatch):
     monkeypatch.setattr(feedback, "_abs_send_time_now", lambda: NOW_ABS)
     sender, clock = Sender(), Clock()
-    session = SimpleNamespace(sender=sender, remb_bps=None, loss_keyframes=0, encoder_restarts=0, link_share=1.0,
-                              link_reserve_bps=0)
+    session = SimpleNamespace(sender=sender, track=Track(), remb_bps=None, loss_keyframes=0, encoder_restarts=0,
+                              link_share=1.0)
     feedback.tap_rtcp(session, clock=clock)
     return session, sender, clock
 
@@ -138,3 +153,25 @@ def test_repeated_hopeless_nacks_make_one_keyframe_per_interval(rig):
     clock.t += feedback.KEYFRAME_MIN_INTERVAL_S
     feed(session, nack(10))
     assert sender.keyframes == 2 and sender.handled == []
+
+
+def next_frame(session):
+    return asyncio.run(session.sender._next_encoded_frame(None))
+
+
+def test_while_the_browser_is_quiet_frames_are_taken_but_not_encoded_and_feedback_resumes_them(rig):
+    session, sender, clock = rig
+    assert next_frame(session) == "frame 1"  # no feedback yet: the stream is starting
+    feed(session, remb(400_000))
+    clock.t += SILENCE_S + 0.1  # an outage: nothing from the browser since
+    assert next_frame(session) == "frame 2"  # one goes, for a browser that answers only media
+    for _ in range(5):
+        clock.t += 0.05
+        assert next_frame(session) is None
+    assert session.track.taken == 5 and session.silence.held == 5  # at the viewer's pace, the newest after
+    clock.t += PROBE_S
+    assert next_frame(session) == "frame 3"
+    feed(session, RtcpRrPacket(ssrc=1, reports=[]))  # any report
+    assert [next_frame(session) for _ in range(3)] == ["frame 4", "frame 5", "frame 6"]
+    assert sender.encoded == 6
+
