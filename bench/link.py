@@ -306,9 +306,9 @@ def run(args) -> dict:
         t_end = time.monotonic()
         if webrtc:  # what the server's adaptation chose by the end of the hold (asked on loopback, not the link)
             session = requests.get(server.url + "/api/camera/whep", timeout=10).json()["sessions"]
-            server_said_video = {k: session[0].get(k) for k in ("level", "width", "height", "fps", "target_bps",
-                                                               "remb_bps", "loss_keyframes",
-                                                               "encoder_restarts")} if session else None
+            keys = ("level", "width", "height", "fps", "target_bps", "remb_bps", "loss_keyframes", "encoder_restarts",
+                    "frames_held")
+            server_said_video = {k: session[0].get(k) for k in keys} if session else None
         stick.release()
         twists = sub.since(mark)
         said = dict(ws.heard.counts)
