@@ -18,7 +18,9 @@
   more than MAX_RESEND_AGE_S ago, nothing is resent and the next frame is a keyframe instead (at
   most one such keyframe per KEYFRAME_MIN_INTERVAL_S: the browser repeats its NACKs). The browser
   then shows a fresh picture about a round trip after the link is back.
-Both wrap the sender's private _handle_rtcp_packet (aiortc is pinned).
+- Silence: any RTCP packet tells silence.py the browser hears us; while it does not, the sender's
+  private _next_encoded_frame takes frames without encoding them.
+These wrap the sender's private _handle_rtcp_packet and _next_encoded_frame (aiortc is pinned).
 """
 
 from __future__ import annotations
