@@ -396,3 +396,30 @@ def test_a_lost_stop_notice_on_the_channel_does_not_lose_a_held_press_for_good(l
     page.keyboard.up("KeyW")
     wait_page(page, lambda: not teleop()["moving"], 10, "and stops")
     assert page.watch.console_errors == []
+
+
+def test_the_look_alike_socket_gives_its_hello_before_any_state(live_server, page):
+    # A state frame that arrives between socket() and the hello's delivery had reached the caller
+    # first (1 run in 4 of the test above). Driven here by a stand-in channel so the order is
+    # certain: the real channel is the test above's.
+    page.goto(live_server.url + "/api/status")
+    got = page.evaluate("""async () => {
+      const { teleopChannel, attachTeleopChannel } = await import('/static/js/camera/teleop_channel.js');
+      const dc = new EventTarget();
+      dc.readyState = 'open';
+      dc.send = () => {};
+      attachTeleopChannel(dc);
+      const frame = (m) => dc.dispatchEvent(new MessageEvent('message', { data: JSON.stringify(m) }));
+      frame({ type: 'hello', epoch: 1, in_control: false, transport: 'datachannel' });
+      const sock = teleopChannel.socket();
+      const seen = [];
+      sock.onmessage = (e) => seen.push(JSON.parse(e.data));
+      frame({ type: 'state', epoch: 2, in_control: true, reason: 'in_control' });
+      frame({ type: 'error', code: 'bad_frame' });
+      await new Promise((r) => setTimeout(r, 50));
+      frame({ type: 'state', epoch: 3, in_control: true, reason: 'moving' });
+      return seen;
+    }""")
+    assert [m["type"] for m in got] == ["hello", "error", "state"], got
+    assert got[0]["epoch"] == 2 and got[0]["in_control"] is True  # the early state folded into it
+    assert got[2]["epoch"] == 3

@@ -69,7 +69,14 @@ function socketOn(dc) {
     close() { end(); },
   };
   const forward = (m) => { if (sock.readyState === OPEN && sock.onmessage) sock.onmessage({ data: JSON.stringify(m) }); };
-  const offMessage = teleopChannel.onMessage(forward);
+  // Until the hello has gone, a state frame is only folded into it (see attachTeleopChannel) and
+  // anything else waits: a state let through first had reached the caller before its hello.
+  let greeted = false;
+  const early = [];
+  const offMessage = teleopChannel.onMessage((m) => {
+    if (greeted) forward(m);
+    else if (m.type !== 'state' && m.type !== 'hello') early.push(m);
+  });
   const offChange = teleopChannel.onChange((open) => { if (!open) end(); });
   function end() {
     if (sock.readyState === CLOSED) return;
@@ -79,6 +86,10 @@ function socketOn(dc) {
     setTimeout(() => { if (sock.onclose) sock.onclose({ code: 1000 }); }, 0);
   }
   // As a WebSocket would: the hello comes first, after the caller has set its handlers.
-  setTimeout(() => { if (hello) forward(hello); }, 0);
+  setTimeout(() => {
+    greeted = true;
+    if (hello) forward(hello);
+    early.splice(0).forEach(forward);
+  }, 0);
   return sock;
 }
