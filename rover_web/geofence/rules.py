@@ -64,12 +64,12 @@ class Fence:
     def __init__(self, areas: Sequence[Area] = ()):
         self.areas = tuple(areas)
         self.keep_out = tuple(a for a in self.areas if a.kind == "keep_out")
-        keep_in = [a.geometry for a in self.areas if a.kind == "keep_in"]
         self.keep_in = None
         if not self.areas:
             return
         import shapely
         from shapely.ops import unary_union
+        keep_in = [a.geometry for a in self.areas if a.kind == "keep_in"]
         self.keep_in = unary_union(keep_in) if keep_in else None
         for geometry in [self.keep_in, *(a.geometry for a in self.keep_out)]:
             if geometry is not None:
