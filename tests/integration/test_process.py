@@ -112,11 +112,15 @@ def test_a_served_app_keeps_its_start_up_heap_out_of_the_collector(tmp_path):
         "import gc, json\n"
         "from rover_web import create_app\n"
         "import os\n"
-        "create_app({'TESTING': True, 'ROVER_WEB_DB_PATH': os.environ['ROVER_WEB_DB_PATH'] + '.test'})\n"
+        "test_app = create_app({'TESTING': True, 'ROVER_WEB_DB_PATH': os.environ['ROVER_WEB_DB_PATH'] + '.test'})\n"
         "testing = gc.get_freeze_count()\n"
-        "create_app()\n"
+        "served_app = create_app()\n"
         "served = gc.get_freeze_count()\n"
         "print(json.dumps({'testing': testing, 'served': served, 'objects': len(gc.get_objects())}))\n"
+        # Stopped before the interpreter exits: leaving two apps' ROS threads running into its
+        # teardown aborted it once in CI ('terminate called without an active exception').
+        "for app in (served_app, test_app):\n"
+        "    app.extensions['rover_web'].shutdown()\n"
     )
     env = subprocess_env(ROVER_WEB_DB_PATH=str(tmp_path / "db.sqlite3"), ROVER_WEB_HOST="127.0.0.1")
     result = subprocess.run([sys.executable, "-c", script], cwd=ROOT, env=env, capture_output=True, text=True,
