@@ -41,7 +41,9 @@ def _init_robot(rover: Rover) -> None:
         runtime.subscribe(msgs.OCCUPANCY_GRID, topic, lambda m, t=topic: service.on_costmap(t, msgs.grid(m)),
                           "latched")
     if service.markers_topic:
-        runtime.subscribe(msgs.MARKER_ARRAY, service.markers_topic, lambda m: service.on_markers(msgs.markers(m)), 10)
+        # share: the 3D view reads the same markers (view3d/__init__.py); one subscription for both
+        runtime.subscribe(msgs.MARKER_ARRAY, service.markers_topic, lambda m: service.on_markers(msgs.markers(m)), 10,
+                          share=True)
     if service.footprint_topic:
         runtime.subscribe(msgs.POLYGON_STAMPED, service.footprint_topic,
                           lambda m: service.on_footprint(*msgs.polygon(m)), 1)

@@ -1,0 +1,64 @@
+"""The 3D view (docs/view3d.md): the robot's URDF model moved by TF, its markers and point cloud.
+
+ROS: subscribes the robot description (std_msgs/String, transient local; ROVER_WEB_ROBOT_DESCRIPTION_TOPIC)
+unless ROVER_WEB_URDF_FILE names a file, a sensor_msgs/PointCloud2 (ROVER_WEB_POINTCLOUD_TOPIC), and the
+overlays' MarkerArray (ROVER_WEB_MARKERS_TOPIC, one subscription shared with them). TF comes from the tf
+feature's buffer (rover_web/tf), which must be set up before this one.
+SSE: `view3d` (every TF frame's pose in the base frame, ROVER_WEB_VIEW3D_POSE_HZ), `view3d_robot` (the
+description changed), `view3d_markers`. HTTP: /3d, /api/3d/robot, /api/3d/mesh/..., /api/3d/cloud.
+Modules: service, urdf_model (parse, errors with their line), meshes (package:// inside share folders),
+cloud (voxel thinning, the binary frame), poses, markers, msgs, routes.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from rover_web.core.fleet import Fleet
+from rover_web.core.state import Rover
+
+from . import msgs, routes
+from .service import CHANNELS, View3dService
+
+log = logging.getLogger(__name__)
+MARKER_EXPIRY_S = 0.5
+
+
+def init_app(app, fleet: Fleet) -> None:
+    for rover in fleet:
+        _init_robot(rover)
+    app.register_blueprint(routes.bp)
+
+
+def _tf_buffer(rover: Rover):
+    try:
+        from rover_web.tf.service import TfService
+    except ImportError:
+        return None
+    try:
+        return rover.feature(TfService).buffer
+    except Exception:  # the tf feature not set up on this app: the model stays at its URDF pose
+        return None
+
+
+def _init_robot(rover: Rover) -> None:
+    service = View3dService(rover)
+    rover.add_feature(service)
+    rover.hub.register(*CHANNELS)
+    rover.add_nav("3D", "/3d")
+    service.tf = _tf_buffer(rover)
+    runtime = rover.runtime
+    if service.urdf_file:
+        service.load_file()
+    elif service.description_topic:
+        runtime.subscribe(msgs.STRING, service.description_topic,
+                          lambda m: service.on_description(msgs.description(m), service.description_topic), "latched")
+    if service.cloud_topic:
+        runtime.subscribe(msgs.POINT_CLOUD2, service.cloud_topic,
+                          lambda m: service.on_cloud(lambda: msgs.point_cloud(m)), "sensor_data")
+    if service.markers_topic:
+        # share: the overlays read the same topic with the same QoS; one subscription serves both
+        runtime.subscribe(msgs.MARKER_ARRAY, service.markers_topic, lambda m: service.on_markers(msgs.markers(m)),
+                          10, share=True, track=not runtime.tracks(service.markers_topic))
+        rover.every(MARKER_EXPIRY_S, service.expire_markers, name="view3d-marker-expiry")
+    rover.every(1.0 / service.pose_hz, service.tick, name="view3d-poses")

@@ -1,0 +1,181 @@
+"""The 3D view of one robot: its description (from /robot_description or a file), the poses of every TF
+frame in its base frame at a tick, its point cloud thinned and packed once per message, its markers.
+
+Everything a viewer gets is computed once and shared: the poses go out on the `view3d` SSE channel
+(conflated: a slow viewer skips ticks), the cloud is one binary frame kept with a sequence number
+that viewers fetch (routes.py), markers on the `view3d_markers` channel.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+
+from rover_web.core.state import Rover
+
+from . import cloud, poses
+from .markers import BadMarker, Markers3d
+from .meshes import package_uri
+from .urdf_model import UrdfError, parse
+
+log = logging.getLogger(__name__)
+
+CHANNELS = ("view3d", "view3d_robot", "view3d_markers")
+MARKERS_MAX_HZ = 10.0
+
+
+class View3dService:
+    def __init__(self, rover: Rover):
+        config = rover.config
+        self.rover = rover
+        self.hub = rover.hub
+        self.description_topic = config["ROVER_WEB_ROBOT_DESCRIPTION_TOPIC"]
+        self.urdf_file = config["ROVER_WEB_URDF_FILE"]
+        self.cloud_topic = config["ROVER_WEB_POINTCLOUD_TOPIC"]
+        self.markers_topic = config["ROVER_WEB_MARKERS_TOPIC"]
+        self.cloud_max_points = config["ROVER_WEB_POINTCLOUD_MAX_POINTS"]
+        self.pose_hz = config["ROVER_WEB_VIEW3D_POSE_HZ"]
+        self.base_frame = config.get("ROVER_WEB_BASE_FRAME", "base_link")
+        self._lock = threading.Lock()
+        self._robot: dict = {"state": "waiting", "source": None, "message": self._waiting_message()}
+        self._robot_seq = 0
+        self._cloud_cond = threading.Condition()
+        self._cloud_raw: cloud.Cloud | None = None
+        self._cloud_frame: bytes | None = None
+        self._cloud_frame_seq = 0
+        self._thin_lock = threading.Lock()
+        self._cloud_seq = 0
+        self._cloud_counts = {"received": 0, "sent": 0, "skipped": {}}
+        self._markers = Markers3d()
+        self._markers_lock = threading.Lock()
+        self.tf = None  # the TF buffer, set by init_app when the tf feature is there
+
+    def _waiting_message(self) -> str:
+        if self.urdf_file:
+            return f"reading {self.urdf_file}"
+        return f"waiting for {self.description_topic} (std_msgs/String, transient local)"
+
+    # --- the robot's description ---
+
+    def on_description(self, text: str, source: str) -> None:
+        """Parse once per description; a bad one is kept with its line so the page can say what is wrong."""
+        try:
+            model = parse(text)
+        except UrdfError as exc:
+            robot = {"state": "error", "source": source, "error": exc.as_dict()}
+        else:
+            meshes = []
+            for uri in model.meshes:
+                found = package_uri(uri)
+                meshes.append({"uri": uri, "url": f"api/3d/mesh/{found[0]}/{found[1]}" if found else None})
+            robot = {"state": "ok", "source": source, "name": model.name, "root": model.root, "links": model.links,
+                     "joints": model.joints, "meshes": meshes, "urdf": text}
+        with self._lock:
+            self._robot_seq += 1
+            robot["seq"] = self._robot_seq
+            self._robot = robot
+        self.hub.publish("view3d_robot", {"seq": robot["seq"], "state": robot["state"]})
+
+    def load_file(self) -> None:
+        try:
+            with open(self.urdf_file, encoding="utf-8") as f:
+                text = f.read()
+        except (OSError, UnicodeDecodeError) as exc:
+            with self._lock:
+                self._robot_seq += 1
+                self._robot = {"state": "error", "source": self.urdf_file, "seq": self._robot_seq,
+                               "error": {"message": f"cannot read {self.urdf_file}: {exc}", "line": None,
+                                         "column": None}}
+            return
+        self.on_description(text, self.urdf_file)
+
+    def robot(self) -> dict:
+        with self._lock:
+            return dict(self._robot, base_frame=self.base_frame, tf=self.tf is not None,
+                        pose_hz=self.pose_hz, cloud_topic=self.cloud_topic or None,
+                        markers_topic=self.markers_topic or None)
+
+    # --- poses, once per tick ---
+
+    def tick(self) -> None:
+        if self.tf is None:
+            return
+        names = poses.frame_names(self.tf)
+        if not names:
+            return
+        self.hub.publish("view3d", {"base": self.base_frame, "t": time.time(),
+                                    "frames": poses.in_base(self.tf, self.base_frame, names)})
+
+    # --- point cloud ---
+
+    def on_cloud(self, read) -> None:
+        """Keep the newest cloud as read (msgs.point_cloud, called here so a bad one is counted). Thinning
+        waits for a viewer to ask (cloud_after): it is the slow part, kept off the executor, and a cloud
+        nobody watches costs no thinning."""
+        counts = self._cloud_counts
+        counts["received"] += 1
+        try:
+            value = read()
+        except cloud.BadCloud as exc:
+            reason = str(exc).split(":")[0]
+            counts["skipped"][reason] = counts["skipped"].get(reason, 0) + 1
+            return
+        with self._cloud_cond:
+            self._cloud_seq += 1
+            self._cloud_raw = value
+            self._cloud_cond.notify_all()
+
+    def _thin(self, value: cloud.Cloud, seq: int) -> bytes:
+        xyz, intensity, voxel = cloud.voxel_thin(value.xyz, self.cloud_max_points, value.intensity)
+        header = {"seq": seq, "frame_id": value.frame_id, "stamp": value.stamp, "source_points": value.source_points,
+                  "voxel_m": round(voxel, 4), "topic": self.cloud_topic}
+        if len(xyz):
+            low, high = xyz.min(axis=0), xyz.max(axis=0)
+            header["extent"] = [[round(float(v), 4) for v in low], [round(float(v), 4) for v in high]]
+            if intensity is not None:
+                header["intensity_range"] = [float(intensity.min()), float(intensity.max())]
+        self._cloud_counts["sent"] += 1
+        return cloud.encode(header, xyz, intensity)
+
+    def cloud_after(self, after: int, wait_s: float) -> tuple[int, bytes | None]:
+        """The newest frame if its sequence is past `after`, waiting up to wait_s for one; (seq, None) if none.
+        The first viewer to ask for a new cloud thins it (under the lock: once per cloud, for all)."""
+        deadline = time.monotonic() + wait_s
+        with self._cloud_cond:
+            # a restarted server's sequence starts again: a viewer ahead of it gets the newest at once
+            while self._cloud_raw is None or after == self._cloud_seq:
+                left = deadline - time.monotonic()
+                if left <= 0 or self.rover.stopping.is_set():
+                    return self._cloud_seq, None
+                self._cloud_cond.wait(min(left, 0.5))
+            seq, raw = self._cloud_seq, self._cloud_raw
+        # Thinned outside the condition's lock, so the subscription callback never waits for it.
+        with self._thin_lock:
+            if self._cloud_frame_seq < seq:
+                self._cloud_frame = self._thin(raw, seq)
+                self._cloud_frame_seq = seq
+            return self._cloud_frame_seq, self._cloud_frame
+
+    def cloud_counts(self) -> dict:
+        return {**self._cloud_counts, "skipped": dict(self._cloud_counts["skipped"]), "seq": self._cloud_seq}
+
+    # --- markers ---
+
+    def on_markers(self, markers: list[dict]) -> None:
+        now = time.monotonic()
+        with self._markers_lock:
+            for marker in markers:
+                try:
+                    self._markers.apply(marker, now)
+                except BadMarker:
+                    continue
+            payload = self._markers.payload()
+        self.hub.publish_throttled("view3d_markers", {"markers": payload}, MARKERS_MAX_HZ)
+
+    def expire_markers(self) -> None:
+        with self._markers_lock:
+            if not self._markers.expire(time.monotonic()):
+                return
+            payload = self._markers.payload()
+        self.hub.publish_throttled("view3d_markers", {"markers": payload}, MARKERS_MAX_HZ)
