@@ -16,6 +16,7 @@ import logging
 
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
+from rover_web.tf import TfService
 
 from . import msgs, routes
 from .service import CHANNELS, View3dService
@@ -30,23 +31,13 @@ def init_app(app, fleet: Fleet) -> None:
     app.register_blueprint(routes.bp)
 
 
-def _tf_buffer(rover: Rover):
-    try:
-        from rover_web.tf.service import TfService
-    except ImportError:
-        return None
-    try:
-        return rover.feature(TfService).buffer
-    except Exception:  # the tf feature not set up on this app: the model stays at its URDF pose
-        return None
-
-
 def _init_robot(rover: Rover) -> None:
     service = View3dService(rover)
     rover.add_feature(service)
     rover.hub.register(*CHANNELS)
     rover.add_nav("3D", "/3d")
-    service.tf = _tf_buffer(rover)
+    tf = rover.feature(TfService)  # set up before this feature (create_app)
+    service.tf, service.tf_missing = tf.buffer, tf.missing
     runtime = rover.runtime
     if service.urdf_file:
         service.load_file()

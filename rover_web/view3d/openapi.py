@@ -19,8 +19,12 @@ PATHS = {
                           "meshes": {"type": "array", "items": obj(closed=False)},
                           "urdf": {"type": "string"}, "error": ERROR, "message": {"type": "string"},
                           "base_frame": {"type": "string"}, "tf": {"type": "boolean"},
+                          "tf_missing": {"type": ["string", "null"]},
                           "pose_hz": {"type": "number"}, "cloud_topic": {"type": ["string", "null"]},
-                          "markers_topic": {"type": ["string", "null"]}}, required=("state",)),
+                          "markers_topic": {"type": ["string", "null"]},
+                          "markers_skipped": obj(closed=False, description="markers not drawn, by reason"),
+                          "cloud": obj(closed=False,
+                                       description="clouds received, sent, skipped by reason")}, required=("state",)),
                   errors={}),
     },
     "/api/3d/mesh/{package}/{path}": {

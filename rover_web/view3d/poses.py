@@ -15,14 +15,15 @@ def _round(values, digits: int = 6) -> list[float]:
 
 
 def frame_names(buffer) -> list[str]:
+    """Every frame the buffer knows: each child frame and each root (a frame only ever a parent)."""
     try:
-        frames = buffer.frames()
+        tree = buffer.frames()
     except Exception:  # a buffer mid-change: this tick shows what the last one did
         return []
-    if isinstance(frames, dict):
-        names = frames.get("frames", frames)
-        return list(names.keys() if isinstance(names, dict) else names)
-    return list(frames)
+    names = list(tree.get("frames", {}))
+    roots = tree.get("roots", [])
+    names += [r if isinstance(r, str) else r.get("frame", "") for r in roots]
+    return sorted({n for n in names if n})
 
 
 def in_base(buffer, base: str, frames: list[str], max_frames: int = 500) -> dict[str, list[float] | None]:

@@ -23,6 +23,7 @@ log = logging.getLogger(__name__)
 
 CHANNELS = ("view3d", "view3d_robot", "view3d_markers")
 MARKERS_MAX_HZ = 10.0
+NAMES_EVERY_S = 1.0
 
 
 class View3dService:
@@ -36,7 +37,7 @@ class View3dService:
         self.markers_topic = config["ROVER_WEB_MARKERS_TOPIC"]
         self.cloud_max_points = config["ROVER_WEB_POINTCLOUD_MAX_POINTS"]
         self.pose_hz = config["ROVER_WEB_VIEW3D_POSE_HZ"]
-        self.base_frame = config.get("ROVER_WEB_BASE_FRAME", "base_link")
+        self.base_frame = config["ROVER_WEB_BASE_FRAME"]
         self._lock = threading.Lock()
         self._robot: dict = {"state": "waiting", "source": None, "message": self._waiting_message()}
         self._robot_seq = 0
@@ -49,7 +50,11 @@ class View3dService:
         self._cloud_counts = {"received": 0, "sent": 0, "skipped": {}}
         self._markers = Markers3d()
         self._markers_lock = threading.Lock()
-        self.tf = None  # the TF buffer, set by init_app when the tf feature is there
+        self.markers_skipped: dict[str, int] = {}  # by reason (markers.py)
+        self._names: list[str] = []
+        self._names_at = 0.0
+        self.tf = None  # the tf feature's TfBuffer, set by init_app
+        self.tf_missing: str | None = None  # why TF cannot be heard (no tf2_msgs), or None
 
     def _waiting_message(self) -> str:
         if self.urdf_file:
@@ -92,16 +97,22 @@ class View3dService:
 
     def robot(self) -> dict:
         with self._lock:
-            return dict(self._robot, base_frame=self.base_frame, tf=self.tf is not None,
+            return dict(self._robot, base_frame=self.base_frame, tf=self.tf is not None and not self.tf_missing,
+                        tf_missing=self.tf_missing,
                         pose_hz=self.pose_hz, cloud_topic=self.cloud_topic or None,
-                        markers_topic=self.markers_topic or None)
+                        markers_topic=self.markers_topic or None, markers_skipped=dict(self.markers_skipped),
+                        cloud=self.cloud_counts())
 
     # --- poses, once per tick ---
 
     def tick(self) -> None:
         if self.tf is None:
             return
-        names = poses.frame_names(self.tf)
+        now = time.monotonic()
+        if now >= self._names_at:  # the tree's snapshot is the costly part: its names once a second
+            self._names = poses.frame_names(self.tf)
+            self._names_at = now + NAMES_EVERY_S
+        names = self._names
         if not names:
             return
         self.hub.publish("view3d", {"base": self.base_frame, "t": time.time(),
@@ -168,8 +179,9 @@ class View3dService:
             for marker in markers:
                 try:
                     self._markers.apply(marker, now)
-                except BadMarker:
-                    continue
+                except BadMarker as exc:
+                    reason = str(exc)
+                    self.markers_skipped[reason] = self.markers_skipped.get(reason, 0) + 1
             payload = self._markers.payload()
         self.hub.publish_throttled("view3d_markers", {"markers": payload}, MARKERS_MAX_HZ)
 

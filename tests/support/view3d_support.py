@@ -53,7 +53,11 @@ def stl_box(size: float = 0.1, height: float = 0.5) -> bytes:
              (2, 3, 7), (2, 7, 6), (3, 0, 4), (3, 4, 7)]
     out = bytearray(b"\0" * 80) + struct.pack("<I", len(faces))
     for a, b, c in faces:
-        out += struct.pack("<3f", 0, 0, 0)
+        u = [v[b][k] - v[a][k] for k in range(3)]
+        w = [v[c][k] - v[a][k] for k in range(3)]
+        n = (u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0])
+        length = sum(x * x for x in n) ** 0.5 or 1.0
+        out += struct.pack("<3f", *(x / length for x in n))
         for i in (a, b, c):
             out += struct.pack("<3f", *v[i])
         out += b"\0\0"
