@@ -225,3 +225,37 @@ def test_without_webgl_the_page_says_so(live_server, page):
     notice = page.locator("#view3d-nowebgl")
     notice.wait_for(state="visible", timeout=10000)
     assert "no WebGL" in notice.inner_text()
+
+
+def test_the_dashboard_card_draws_the_model_and_stops_while_hidden(live_server_factory, page, tmp_path, monkeypatch):
+    import requests
+
+    monkeypatch.setenv("AMENT_PREFIX_PATH", str(ament_prefix(tmp_path)))
+    urdf = tmp_path / "robot.urdf"
+    urdf.write_text(ROBOT_URDF)
+    server = live_server_factory(ROVER_WEB_URDF_FILE=str(urdf), ROVER_WEB_POINTCLOUD_TOPIC="/points")
+    doc = {"version": 1, "name": "3D", "cards": [{"type": "view3d", "x": 0, "y": 0, "w": 6, "h": 6,
+                                                  "settings": {"fixed": "robot"}}]}
+    made = requests.post(server.url + "/api/layouts", json=doc, timeout=5)
+    assert made.status_code == 201, made.text
+    assert requests.put(server.url + "/api/me/layout", json={"id": made.json()["id"]}, timeout=5).status_code == 200
+    cloud_polls = []
+    page.on("request", lambda r: cloud_polls.append(time.monotonic()) if "/api/3d/cloud" in r.url else None)
+    page.goto(server.url + "/")
+    stage = page.locator("[data-view3d-stage]")
+    wait_until(lambda: stage.get_attribute("data-links") == "3", 20, "the card's model built")
+    image = Image.open(io.BytesIO(stage.locator("canvas").screenshot())).convert("RGB")
+    p = page.evaluate("() => document.querySelector('[data-view3d-stage]').view3d.project(-0.2, -0.2, 0.1)")
+    r, g, b = image.getpixel((round(p["x"]), round(p["y"])))
+    assert b > 110 and r < 90 and g < 90, (r, g, b)  # the blue base at the robot's origin
+    wait_until(lambda: cloud_polls, 10, "the card asks for the cloud while shown")
+    # Hidden (another tab in front): no more drawing and no more cloud requests.
+    page.evaluate("""() => { Object.defineProperty(document, 'hidden', { value: true, configurable: true });
+                             document.dispatchEvent(new Event('visibilitychange')); }""")
+    time.sleep(0.5)
+    drawn, polls = stage.get_attribute("data-drawn"), len(cloud_polls)
+    page.evaluate("() => document.querySelector('[data-view3d-stage]').view3d.requestDraw()")
+    time.sleep(3)
+    assert stage.get_attribute("data-drawn") == drawn
+    assert len(cloud_polls) == polls
+    assert page.watch.console_errors == []
