@@ -259,3 +259,58 @@ def test_the_dashboard_card_draws_the_model_and_stops_while_hidden(live_server_f
     assert stage.get_attribute("data-drawn") == drawn
     assert len(cloud_polls) == polls
     assert page.watch.console_errors == []
+
+
+def test_livemap_overlays_in_3d_in_the_map_frame(live_server_factory, ros_peer, page, tmp_path, monkeypatch):
+    """The scan, a costmap and the plan the overlays already send, drawn on the ground where the map
+    frame is (map -> odom from TF), from the same channels LiveMap reads."""
+    monkeypatch.setenv("AMENT_PREFIX_PATH", str(ament_prefix(tmp_path)))
+    urdf = UrdfPeer(ros_peer("urdf_peer"))
+    urdf.peer.publish("/tf_static", {"transforms": [transform("base_link", "mast", (-0.2, 0, 0.1), t=0),
+                                                    transform("map", "odom", (-1.0, 0.0, 0), t=0)]})
+    urdf.peer.advertise("/scan", "sensor_msgs/msg/LaserScan", qos="sensor_data")
+    urdf.peer.advertise("/global_costmap/costmap", "nav_msgs/msg/OccupancyGrid", qos="latched")
+    urdf.peer.advertise("/plan", "nav_msgs/msg/Path", qos=1)
+    server = live_server_factory(ROVER_WEB_COSTMAP_TOPICS=["/global_costmap/costmap"])
+    # a lethal square 1 m a side at (3, -3)..(4, -2) in the map frame
+    urdf.peer.publish("/global_costmap/costmap", {
+        "header": {"frame_id": "map"},
+        "info": {"width": 10, "height": 10, "resolution": 0.1,
+                 "origin": {"position": {"x": 3.0, "y": -3.0}, "orientation": {"w": 1.0}}},
+        "data": [100] * 100})
+    page.goto(server.url + "/3d")
+    wait_until(lambda: dataset(page).get("links") == "3", 20, "the model built")
+    page.check("[data-layer='costmap']")
+    page.select_option("#view3d-fixed", "map")
+    ranges = [float("inf")] * 360
+    ranges[180] = 3.0  # straight ahead, along the map's +x (a scan in the map frame, as a simulator's)
+    scan = {"header": {"frame_id": "map"}, "angle_min": -math.pi, "angle_max": math.pi - math.pi / 180,
+            "angle_increment": math.pi / 180, "range_min": 0.05, "range_max": 20.0, "ranges": ranges}
+    plan = {"header": {"frame_id": "map"},
+            "poses": [{"header": {"frame_id": "map"}, "pose": {"position": {"x": float(x), "y": 2.0}}}
+                      for x in range(5)]}
+
+    def drawn():
+        urdf.joint(0.0)
+        urdf.peer.publish("/scan", scan)
+        urdf.peer.publish("/plan", plan)
+        return page.evaluate("""() => { const v = document.getElementById('view3d').view3d;
+            const n = (name) => v.overlays.groups[name].children.length;
+            return v.overlays.map.visible && n('scan') && n('costmap') && n('plan') ? true : false; }""")
+    wait_until(drawn, 20, "scan, costmap and plan in 3D", interval=0.3)
+    page.evaluate("""() => { const v = document.getElementById('view3d').view3d;
+                             v.camera.position.set(2, 0, 10); v.controls.target.set(2, 0, 0);
+                             v.controls.update(); v.requestDraw(); }""")
+    time.sleep(0.5)
+    image = canvas_image(page)
+
+    def rgb(x, y, z):
+        p = page.evaluate("([x, y, z]) => document.getElementById('view3d').view3d.project(x, y, z)", [x, y, z])
+        return image.getpixel((round(p["x"]), round(p["y"])))
+
+    r, g, b = rgb(3.0, 0.0, 0.1)
+    assert r > 150 and g < 100, (r, g, b)           # the scan's return, 3 m along the map's x
+    r, g, b = rgb(3.5, -2.5, 0.01)
+    assert r > 90 and b > 90 and g < 60, (r, g, b)  # the lethal costmap, magenta, at its map cells
+    assert max(rgb(5.5, -2.5, 0.01)) < 60          # nothing past the costmap's edge
+    assert page.watch.console_errors == []

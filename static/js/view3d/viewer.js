@@ -7,6 +7,7 @@ import { api, at } from '../api.js';
 import { on } from '../live.js';
 import { CloudLayer } from './cloud.js';
 import { MarkerLayer } from './markers.js';
+import { Overlays } from './overlays.js';
 import { Poses } from './poses.js';
 import { RobotModel } from './robot.js';
 import { TfAxes } from './tf_axes.js';
@@ -49,6 +50,10 @@ export class Viewer {
       markers: new MarkerLayer(this.scene, at('/api/3d/mesh')),
       cloud: new CloudLayer(this.scene),
     };
+    const overlays = new Overlays(this.scene, () => this.requestDraw());
+    this.overlays = overlays;
+    for (const name of ['scan', 'costmap', 'grid', 'plan']) this.layers[name] = { group: overlays.groups[name] };
+    this.layers.gps = { group: overlays.gps };
     this.layers.tf.group.visible = false;
     this.follow = false;
     this.frames = 0;
@@ -130,6 +135,7 @@ export class Viewer {
     this.layers.tf.place(this.poses);
     this.layers.markers.place(this.poses);
     this.layers.cloud.place(this.poses);
+    this.overlays.place(this.poses, this.layers.robot.rootPosition());
     if (this.follow) {
       const target = this.layers.robot.rootPosition();
       this.camera.position.add(target.clone().sub(this.controls.target));
