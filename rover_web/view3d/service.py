@@ -46,6 +46,7 @@ class View3dService:
         self._cloud_frame: bytes | None = None
         self._cloud_frame_seq = 0
         self._thin_lock = threading.Lock()
+        self._last_voxel = 0.0  # the voxel that fitted the last cloud: the next one's first guess
         self._cloud_seq = 0
         self._cloud_counts = {"received": 0, "sent": 0, "skipped": {}}
         self._markers = Markers3d()
@@ -138,7 +139,9 @@ class View3dService:
             self._cloud_cond.notify_all()
 
     def _thin(self, value: cloud.Cloud, seq: int) -> bytes:
-        xyz, intensity, voxel = cloud.voxel_thin(value.xyz, self.cloud_max_points, value.intensity)
+        xyz, intensity, voxel = cloud.voxel_thin(value.xyz, self.cloud_max_points, value.intensity,
+                                                 guess_m=self._last_voxel)
+        self._last_voxel = voxel
         header = {"seq": seq, "frame_id": value.frame_id, "stamp": value.stamp, "source_points": value.source_points,
                   "voxel_m": round(voxel, 4), "topic": self.cloud_topic}
         if len(xyz):
