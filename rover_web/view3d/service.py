@@ -107,7 +107,8 @@ class View3dService:
     # --- poses, once per tick ---
 
     def tick(self) -> None:
-        if self.tf is None:
+        # No event stream open on this robot: nobody could be shown the poses, so none are looked up.
+        if self.tf is None or self.hub.client_count == 0:
             return
         now = time.monotonic()
         if now >= self._names_at:  # the tree's snapshot is the costly part: its names once a second
