@@ -38,6 +38,8 @@ class View3dService:
         self.cloud_max_points = config["ROVER_WEB_POINTCLOUD_MAX_POINTS"]
         self.pose_hz = config["ROVER_WEB_VIEW3D_POSE_HZ"]
         self.base_frame = config["ROVER_WEB_BASE_FRAME"]
+        self.map_frame = config["ROVER_WEB_MAP_FRAME"]
+        self.odom_frame = config["ROVER_WEB_ODOM_FRAME"]
         self._lock = threading.Lock()
         self._robot: dict = {"state": "waiting", "source": None, "message": self._waiting_message()}
         self._robot_seq = 0
@@ -145,6 +147,9 @@ class View3dService:
         self._last_voxel = voxel
         header = {"seq": seq, "frame_id": value.frame_id, "stamp": value.stamp, "source_points": value.source_points,
                   "voxel_m": round(voxel, 4), "topic": self.cloud_topic}
+        placed = self._placed_at(value.frame_id, value.stamp)
+        if placed:
+            header["at_stamp"] = placed
         if len(xyz):
             low, high = xyz.min(axis=0), xyz.max(axis=0)
             header["extent"] = [[round(float(v), 4) for v in low], [round(float(v), 4) for v in high]]
@@ -152,6 +157,20 @@ class View3dService:
                 header["intensity_range"] = [float(intensity.min()), float(intensity.max())]
         self._cloud_counts["sent"] += 1
         return cloud.encode(header, xyz, intensity)
+
+    def _placed_at(self, frame: str, stamp: float) -> dict:
+        """The cloud's frame in each fixed frame the page offers, at the cloud's stamp (tf2 interpolates),
+        so a moving robot's cloud lands where it was taken; the page falls back to the latest pose."""
+        if self.tf is None or stamp <= 0:
+            return {}
+        placed = {}
+        for fixed in {self.map_frame, self.odom_frame, self.base_frame}:
+            try:
+                t = self.tf.lookup(fixed, frame, int(stamp * 1e9))
+            except Exception:  # TfError: not connected, or the stamp is outside the cache
+                continue
+            placed[fixed] = [round(float(v), 6) for v in (*t.translation, *t.rotation)]
+        return placed
 
     def cloud_after(self, after: int, wait_s: float) -> tuple[int, bytes | None]:
         """The newest frame if its sequence is past `after`, waiting up to wait_s for one; (seq, None) if none.

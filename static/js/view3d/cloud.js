@@ -3,6 +3,7 @@
 // cloud twice and a slow one skips to the newest). Only while the view is shown: stop() ends the loop.
 import * as THREE from './three.js';
 import { at } from '../api.js';
+import { matrixOf } from './poses.js';
 
 export function decodeCloud(buffer) {
   const view = new DataView(buffer);
@@ -58,8 +59,11 @@ export class CloudLayer {
     this.last = cloud;
   }
 
+  // Where the cloud was taken: its frame in the fixed frame at its stamp when the server could say
+  // (header.at_stamp), else the frame's latest pose.
   place(poses) {
-    const m = this.frame ? poses.inFixed(this.frame) : null;
+    const atStamp = this.last?.header.at_stamp?.[poses.fixedName()];
+    const m = atStamp ? matrixOf(atStamp) : (this.frame ? poses.inFixed(this.frame) : null);
     this.points.visible = Boolean(m);
     if (m) { this.group.matrix.copy(m); this.group.matrixWorldNeedsUpdate = true; }
   }

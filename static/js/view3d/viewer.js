@@ -61,7 +61,7 @@ export class Viewer {
     this.shown = true;
     this.robotSeq = 0;
     this.dirty = true;
-    this.layers.cloud.onFrame = () => this.requestDraw();
+    this.layers.cloud.onFrame = () => { this.layers.cloud.place(this.poses); this.requestDraw(); };
     on('view3d', (data) => { this.poses.update(data); this.placeAll(); });
     on('view3d_robot', (data) => { if (data.seq !== this.robotSeq) this.loadRobot(); });
     on('view3d_markers', (data) => { this.layers.markers.set(data.markers || []); this.placeAll(); });

@@ -76,3 +76,17 @@ def test_a_new_description_replaces_the_last(service):
     service.on_description(BAD_URDF, "/robot_description")
     robot = service.robot()
     assert robot["state"] == "error" and robot["seq"] == 2 and "urdf" not in robot
+
+
+def test_a_cloud_is_placed_where_its_frame_was_at_its_stamp(service):
+    service.tf.set_transform("map", "odom", (0, 0, 0), (0, 0, 0, 1), 0, static=True)
+    service.tf.set_transform("odom", "moving", (0, 0, 0), (0, 0, 0, 1), 10 * 10**9, static=False)
+    service.tf.set_transform("odom", "moving", (2, 0, 0), (0, 0, 0, 1), 11 * 10**9, static=False)
+    xyz = np.zeros((3, 3), np.float32)
+    service.on_cloud(lambda: cloud.Cloud("moving", 10.25, xyz, None, 3))
+    header, _, _ = cloud.decode(service.cloud_after(0, 1.0)[1])
+    assert header["at_stamp"]["odom"][:3] == pytest.approx([0.5, 0, 0])   # a quarter of the way, not the newest
+    assert header["at_stamp"]["map"][:3] == pytest.approx([0.5, 0, 0])
+    service.on_cloud(lambda: cloud.Cloud("moving", 99.0, xyz, None, 3))  # past the newest transform
+    header, _, _ = cloud.decode(service.cloud_after(1, 1.0)[1])
+    assert "odom" not in header.get("at_stamp", {})
