@@ -314,3 +314,32 @@ def test_livemap_overlays_in_3d_in_the_map_frame(live_server_factory, ros_peer, 
     assert r > 90 and b > 90 and g < 60, (r, g, b)  # the lethal costmap, magenta, at its map cells
     assert max(rgb(5.5, -2.5, 0.01)) < 60          # nothing past the costmap's edge
     assert page.watch.console_errors == []
+
+
+def test_follow_the_robot_and_orbit_by_touch(scene, page):
+    server, urdf = scene
+    look_down(page, urdf, 0.0)
+    page.check("#view3d-follow")
+    target = "() => document.getElementById('view3d').view3d.controls.target.toArray()"
+    assert page.evaluate(target)[:2] == pytest.approx(list(BASE_IN_ODOM), abs=1e-3)
+
+    def moved():
+        now = time.time()
+        urdf.peer.publish("/tf", {"transforms": [transform("odom", "base_link", (5.0, -2.0, 0), t=now),
+                                                 transform("base_link", "arm", (0, 0, 0.15), t=now)]})
+        return page.evaluate(target)[:2] == pytest.approx([5.0, -2.0], abs=1e-3)
+    wait_until(moved, 15, "the camera following the robot to (5, -2)", interval=0.3)
+
+    # One finger dragged across the stage orbits the camera about the robot (OrbitControls' touch rotate).
+    camera = "() => document.getElementById('view3d').view3d.camera.position.toArray()"
+    before = page.evaluate(camera)
+    box = page.locator("#view3d canvas").bounding_box()
+    x0, y0 = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    cdp = page.context.new_cdp_session(page)
+    cdp.send("Input.dispatchTouchEvent", {"type": "touchStart", "touchPoints": [{"x": x0, "y": y0}]})
+    for step in range(1, 11):
+        cdp.send("Input.dispatchTouchEvent", {"type": "touchMove", "touchPoints": [{"x": x0 + 20 * step, "y": y0}]})
+    cdp.send("Input.dispatchTouchEvent", {"type": "touchEnd", "touchPoints": []})
+    after = page.evaluate(camera)
+    assert after != pytest.approx(before, abs=1e-3)
+    assert page.evaluate(target)[:2] == pytest.approx([5.0, -2.0], abs=1e-3)  # still about the robot
