@@ -26,7 +26,7 @@ export class Viewer {
     this.container = container;
     this.statusEl = status;
     this.poses = new Poses();
-    this.renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
+    this.renderer = new THREE.WebGLRenderer({ antialias: false });
     this.renderer.setPixelRatio(1);
     this.renderer.setClearColor(0x1b1f24);
     container.appendChild(this.renderer.domElement);
