@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import math
+import threading
 
 from flask import Blueprint, Response, jsonify, render_template, request, send_file
 
+from rover_web.auth import on_revoke
 from rover_web.core.state import current_feature
 from rover_web.web.http import ApiError
 from rover_web.web.streams import opening
@@ -70,11 +72,14 @@ def cloud():
     after = int(_number("after", "bad_after", 0, 0, 2**53))
     wait_s = _number("wait", "bad_wait", 0, 0, CLOUD_MAX_WAIT_S)
     if wait_s > 0:
-        with opening("view3d_cloud") as slot:
+        ended = threading.Event()
+        with opening("view3d_cloud") as slot, on_revoke(lambda _reason: feature.end_waits(ended)):
             try:
-                seq, frame = feature.cloud_after(after, wait_s)
+                seq, frame = feature.cloud_after(after, wait_s, ended)
             finally:
                 slot.release()
+        if ended.is_set():
+            raise ApiError(401, "revoked", "the credentials this request was made with have ended")
     else:
         seq, frame = feature.cloud_after(after, 0)
     if frame is None:

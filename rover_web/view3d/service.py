@@ -172,15 +172,17 @@ class View3dService:
             placed[fixed] = [round(float(v), 6) for v in (*t.translation, *t.rotation)]
         return placed
 
-    def cloud_after(self, after: int, wait_s: float) -> tuple[int, bytes | None]:
+    def cloud_after(self, after: int, wait_s: float, ended: threading.Event | None = None
+                    ) -> tuple[int, bytes | None]:
         """The newest frame if its sequence is past `after`, waiting up to wait_s for one; (seq, None) if none.
-        The first viewer to ask for a new cloud thins it (under the lock: once per cloud, for all)."""
+        The first viewer to ask for a new cloud thins it (once per cloud, for all). `ended`: set (with
+        end_waits) when the request's credential is revoked, to stop waiting at once."""
         deadline = time.monotonic() + wait_s
         with self._cloud_cond:
             # a restarted server's sequence starts again: a viewer ahead of it gets the newest at once
             while self._cloud_raw is None or after == self._cloud_seq:
                 left = deadline - time.monotonic()
-                if left <= 0 or self.rover.stopping.is_set():
+                if left <= 0 or self.rover.stopping.is_set() or (ended is not None and ended.is_set()):
                     return self._cloud_seq, None
                 self._cloud_cond.wait(min(left, 0.5))
             seq, raw = self._cloud_seq, self._cloud_raw
@@ -190,6 +192,12 @@ class View3dService:
                 self._cloud_frame = self._thin(raw, seq)
                 self._cloud_frame_seq = seq
             return self._cloud_frame_seq, self._cloud_frame
+
+    def end_waits(self, ended: threading.Event) -> None:
+        """Wake the waiting requests so the one whose `ended` is set returns (its credential ended)."""
+        ended.set()
+        with self._cloud_cond:
+            self._cloud_cond.notify_all()
 
     def cloud_counts(self) -> dict:
         return {**self._cloud_counts, "skipped": dict(self._cloud_counts["skipped"]), "seq": self._cloud_seq}

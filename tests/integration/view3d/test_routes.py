@@ -104,3 +104,29 @@ def test_every_route_needs_a_viewer(signed_server_factory, prefix, path):
     assert anonymous.status_code == 401
     seen = requests.get(server.url + path, timeout=10, headers=bearer(server, "viewer"))
     assert seen.status_code in (200, 204), seen.text
+
+
+def test_a_waiting_cloud_request_ends_when_its_token_is_revoked(signed_server_factory):
+    import threading
+    import time
+
+    import requests
+
+    server = signed_server_factory(ROVER_WEB_POINTCLOUD_TOPIC="/points")
+    admin = bearer(server, "admin")
+    tokens = requests.get(server.url + "/api/tokens", headers=admin, timeout=5).json()["tokens"]
+    viewer_token = next(t["id"] for t in tokens if t["user"] == "viewer")
+    answer = {}
+
+    def wait():
+        t0 = time.monotonic()
+        reply = requests.get(server.url + "/api/3d/cloud", params={"wait": 2}, headers=bearer(server, "viewer"),
+                             timeout=10)
+        answer.update(status=reply.status_code, error=reply.json().get("error"), after_s=time.monotonic() - t0)
+    waiter = threading.Thread(target=wait)
+    waiter.start()
+    time.sleep(0.5)
+    assert requests.delete(f"{server.url}/api/tokens/{viewer_token}", headers=admin, timeout=5).ok
+    waiter.join(10)
+    assert answer["status"] == 401 and answer["error"] == "revoked"
+    assert answer["after_s"] < 1.5  # ended by the revocation, not by its 2 s wait
