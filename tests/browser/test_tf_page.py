@@ -1,0 +1,80 @@
+"""The TF page in Chromium, with the app's Content-Security-Policy enforced: a peer's tree drawn as
+view_frames draws it (each frame under its parent), a frame's details on a click, the warnings, a
+lookup through the form, a new frame appearing live, a refused lookup saying tf2's reason."""
+
+import math
+import time
+
+import pytest
+
+from rover_web.tf import TfService
+from tests.conftest import PageWatch
+from tests.integration.tf.test_tf_ros import TF, transform, yaw_q
+from tests.support.waiting import wait_until
+
+pytestmark = [pytest.mark.browser, pytest.mark.ros]
+
+RECORD_VIOLATIONS = """
+window.__csp = [];
+document.addEventListener('securitypolicyviolation', (e) => window.__csp.push(`${e.violatedDirective} ${e.sample}`));
+"""
+
+
+def test_the_tf_page_draws_the_tree_details_warnings_and_lookups(live_server, ros_peer, browser):
+    peer = ros_peer("tf_page_peer")
+    peer.advertise("/tf_static", TF, qos="latched")
+    peer.publish("/tf_static", {"transforms": [transform("map", "odom", (1, 2, 0), (0, 0, 0, 1)),
+                                               transform("base_link", "laser", (0.3, 0, 0.2), (0, 0, 0, 1)),
+                                               transform("world", "gps_origin", (0, 0, 0), (0, 0, 0, 1))]})
+    peer.advertise("/tf", TF, qos=100)
+    peer.wait_match("/tf")
+    wait_until(lambda: live_server.rover.feature(TfService).buffer.can_transform("map", "odom"), 10,
+               "the static transforms")
+    now = time.time()
+    for i in range(5):
+        peer.publish("/tf", {"transforms": [transform("odom", "base_link", (i, 0, 0), yaw_q(math.pi / 2),
+                                                      now + i * 0.1)]})
+
+    context = browser.new_context(viewport={"width": 1280, "height": 900})  # the policy enforced
+    context.add_init_script(RECORD_VIOLATIONS)
+    try:
+        page = context.new_page()
+        watch = PageWatch(page)
+        page.goto(live_server.url + "/tf")
+        page.wait_for_selector("body[data-link='up']", timeout=15000)
+        # view_frames' shape: laser under base_link under odom under map; world a second root.
+        page.wait_for_selector(".tf-frame[data-frame='map'][data-root='true'] ~ ul .tf-frame[data-frame='odom'] "
+                               "~ ul .tf-frame[data-frame='base_link'] ~ ul .tf-frame[data-frame='laser']",
+                               timeout=10000)
+        assert page.get_attribute(".tf-frame[data-frame='laser']", "data-static") == "true"
+        assert page.get_attribute(".tf-frame[data-frame='base_link']", "data-static") == "false"
+        assert page.get_attribute(".tf-frame[data-frame='world']", "data-root") == "true"
+        assert "unconnected trees" in page.inner_text("#tf-warnings")
+        page.click(".tf-frame[data-frame='base_link']")
+        page.wait_for_selector("#tf-details dd[data-field='parent']", timeout=5000)
+        assert page.inner_text("#tf-details dd[data-field='parent']") == "odom"
+        assert page.inner_text("#tf-details dd[data-field='kind']") == "dynamic"
+        assert page.inner_text("#tf-details dd[data-field='rate']") == "10.0 Hz"
+        # A lookup: the robot at odom (4, 0) facing +y; the laser 0.3 ahead of it, so at map (5, 2.3).
+        page.fill("#tf-target", "map")
+        page.fill("#tf-source", "laser")
+        page.click(".tf-lookup button[type='submit']")
+        page.wait_for_selector("#tf-lookup-result[data-error='false']", timeout=5000)
+        assert "translation 5.000 2.300 0.200 m" in page.inner_text("#tf-lookup-result")
+        assert "yaw 90.0°" in page.inner_text("#tf-lookup-result")
+        page.fill("#tf-source", "camera")
+        page.click(".tf-lookup button[type='submit']")
+        page.wait_for_selector("#tf-lookup-result[data-error='true']", timeout=5000)
+        assert page.inner_text("#tf-lookup-result").startswith('unknown_frame: "camera" passed to lookupTransform')
+        # A new frame shows without a reload (the `tf` channel), and the details follow it.
+        peer.publish("/tf_static", {"transforms": [transform("base_link", "camera", (0.1, 0, 0.5), (0, 0, 0, 1))]})
+        page.wait_for_selector(".tf-frame[data-frame='base_link'] ~ ul .tf-frame[data-frame='camera']", timeout=10000)
+        assert page.inner_text("#tf-details dd[data-field='children']") == "camera, laser"
+        page.wait_for_load_state("networkidle")
+        assert page.evaluate("window.__csp") == []
+        # The one console error is the browser's own line about the refused lookup's 404.
+        assert watch.console_errors == ["Failed to load resource: the server responded with a status of 404 "
+                                        "(NOT FOUND)"]
+        assert watch.offhost == []
+    finally:
+        context.close()
