@@ -78,3 +78,16 @@ def test_the_tf_page_draws_the_tree_details_warnings_and_lookups(live_server, ro
         assert watch.offhost == []
     finally:
         context.close()
+
+
+def test_the_tf_page_fits_a_phone(live_server, ros_peer, browser):
+    from tests.browser.test_phone import wide_pages
+
+    peer = ros_peer("tf_phone_peer")
+    peer.advertise("/tf_static", TF, qos="latched")
+    chain = [transform("map" if i == 0 else f"a_rather_long_frame_name_{i - 1}", f"a_rather_long_frame_name_{i}",
+                       (0, 0, 0), (0, 0, 0, 1)) for i in range(8)]
+    peer.publish("/tf_static", {"transforms": chain})
+    wait_until(lambda: live_server.rover.feature(TfService).buffer.can_transform("map", "a_rather_long_frame_name_7"),
+               10, "the chain")
+    assert wide_pages(browser, live_server.url, {"/tf": [".tf-frame[data-frame='a_rather_long_frame_name_7']"]}) == ""
