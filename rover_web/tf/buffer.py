@@ -526,8 +526,12 @@ class TfBuffer:
                                  "message": f"{len(roots)} unconnected trees (roots "
                                             + ", ".join(f"[{r}]" for r in roots)
                                             + "): lookups between them fail"})
+            children: dict[str, list[str]] = {}
             for name, row in rows.items():
-                row["children"] = sorted(c for c, r in rows.items() if r["parent"] == name)
+                if row["parent"] is not None:
+                    children.setdefault(row["parent"], []).append(name)
+            for name, row in rows.items():
+                row["children"] = sorted(children.get(name, ()))
                 row["in_loop"] = name in in_loop
             rejected = [{"reason": r, "count": c, "message": self.last_rejection.get(r, "")}
                         for r, c in sorted(self.rejected.items())]
