@@ -91,3 +91,39 @@ def test_the_tf_page_fits_a_phone(live_server, ros_peer, browser):
     wait_until(lambda: live_server.rover.feature(TfService).buffer.can_transform("map", "a_rather_long_frame_name_7"),
                10, "the chain")
     assert wide_pages(browser, live_server.url, {"/tf": [".tf-frame[data-frame='a_rather_long_frame_name_7']"]}) == ""
+
+
+def test_a_recordings_frames_on_the_tf_page(live_server, browser, tmp_path):
+    from tests.integration.tf.test_tf_replay import T0, write_tf_run
+    from tests.support.mcap_files import upload
+
+    answer = upload(live_server, write_tf_run(tmp_path / "tf.mcap"), name="tf run")
+    assert answer.status_code == 201, answer.text
+    rid = answer.json()["id"]
+    context = browser.new_context(viewport={"width": 1280, "height": 900})  # the policy enforced
+    context.add_init_script(RECORD_VIOLATIONS)
+    try:
+        page = context.new_page()
+        watch = PageWatch(page)
+        page.goto(f"{live_server.url}/recordings/{rid}/replay")
+        page.click("#replay-tf")
+        page.wait_for_selector(".tf-frame[data-frame='odom'] ~ ul .tf-frame[data-frame='base_link'] "
+                               "~ ul .tf-frame[data-frame='laser']", timeout=10000)
+        page.fill("input[name='t']", f"{T0 + 20:.3f}")
+        page.click("form.tf-lookup:not(#tf-lookup) button[type='submit']")
+        page.wait_for_url(f"**/recordings/{rid}/tf?t=*")
+        page.wait_for_selector(".tf-frame[data-frame='laser']", timeout=10000)
+        page.click(".tf-frame[data-frame='base_link']")
+        assert page.inner_text("#tf-details dd[data-field='rate']") == "20.0 Hz"
+        assert page.inner_text("#tf-details dd[data-field='newest stamp']") == f"{T0 + 20:.3f} s"
+        # The lookup asks the recording (its URL already holds ?t=): at s = 12.5 the laser is at map (5, 12.7).
+        page.fill("#tf-target", "map")
+        page.fill("#tf-source", "laser")
+        page.fill("#tf-time", f"{T0 + 12.5}")
+        page.click("#tf-lookup button[type='submit']")
+        page.wait_for_selector("#tf-lookup-result[data-error='false']", timeout=5000)
+        assert "translation 5.000 12.700 0.100 m" in page.inner_text("#tf-lookup-result")
+        assert page.evaluate("window.__csp") == []
+        assert watch.console_errors == [] and watch.offhost == []
+    finally:
+        context.close()
