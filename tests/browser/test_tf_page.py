@@ -106,7 +106,9 @@ def test_a_recordings_frames_on_the_tf_page(live_server, browser, tmp_path):
         page = context.new_page()
         watch = PageWatch(page)
         page.goto(f"{live_server.url}/recordings/{rid}/replay")
+        page.wait_for_selector("#replay-tf[href*='?t=']", timeout=10000)  # follows the slider
         page.click("#replay-tf")
+        page.wait_for_url(f"**/recordings/{rid}/tf?t={T0:.3f}")  # the slider starts at the beginning
         page.wait_for_selector(".tf-frame[data-frame='odom'] ~ ul .tf-frame[data-frame='base_link'] "
                                "~ ul .tf-frame[data-frame='laser']", timeout=10000)
         page.fill("input[name='t']", f"{T0 + 20:.3f}")
