@@ -110,3 +110,24 @@ def test_a_file_from_elsewhere_shows_its_frames(live_server):
     assert tree["frames"]["child_frame"]["parent"] == "test_frame"
     got = get(live_server, rid, "tf/lookup", target="test_frame", source="child_frame").json()
     assert got["translation"] == [1.0, 2.0, 3.0] and got["rotation"] == [0.0, 0.0, 0.0, 1.0]
+
+
+def test_flask_replay_of_a_tf_recording_reaches_the_live_tf_page(live_server, tmp_path):
+    """`flask replay` republishes the file: /tf_static transient local (tf2's listeners take nothing
+    else), /tf as recorded; the running server's TF page shows both."""
+    import subprocess
+    import sys
+
+    from rover_web.config import ROOT
+    from tests.support.rospeer import subprocess_env
+
+    path = write_tf_run(tmp_path / "tf.mcap")
+    done = subprocess.run([sys.executable, "-m", "flask", "--app", "rover_web", "replay", str(path), "--rate", "10",
+                           "--delay", "2"], cwd=ROOT, env=subprocess_env(), capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    tree = requests.get(live_server.url + "/api/tf", timeout=5).json()
+    assert tree["frames"]["laser"]["static"] is True and tree["frames"]["laser"]["parent"] == "base_link"
+    assert tree["frames"]["base_link"]["newest_stamp"] == pytest.approx(T0 + 29.95)
+    got = requests.get(live_server.url + "/api/tf/lookup", params={"target": "map", "source": "laser"},
+                       timeout=5).json()
+    assert got["translation"] == pytest.approx([5.0, 30.15, 0.1], abs=1e-6)  # odom x = 29.95, turned 90°
