@@ -40,6 +40,7 @@ MAX_GRAPH_DEPTH = 1000
 # divide by; a normalised lerp there is within 1e-11 rad of it.
 NLERP_DOT = 1.0 - 1e-7
 MAX_PATHS = 4096  # (target, source) pairs whose path is kept; past it the cache starts again
+MAX_FRAMES = 10_000  # a robot has hundreds; a buggy publisher stamping ids with a counter is held here
 KINDS = ("unknown_frame", "not_connected", "extrapolation_past", "extrapolation_future", "invalid")
 
 Quaternion = tuple[float, float, float, float]
@@ -297,6 +298,9 @@ class TfBuffer:
             norm2 = qx * qx + qy * qy + qz * qz + qw * qw
             frame = self._frames.get(child)
             if frame is None:
+                if len(self._frames) >= MAX_FRAMES:
+                    return self._reject("too_many_frames", f"[{child}] would be frame {MAX_FRAMES + 1}: a publisher "
+                                                           "inventing frame ids must not exhaust memory")
                 frame = self._frames[child] = _Frame(child, parent, static)
             frame.received += 1
             frame.last_norm2 = norm2

@@ -290,3 +290,15 @@ def test_between_two_close_rotations_slerp_is_still_exact(q, axis, angle, r):
     oracle = Slerp([0.0, 1.0], Rotation.from_quat([q, qb]))([(stamp - 10 * S) / S])
     np.testing.assert_allclose(Rotation.from_quat(got).as_matrix(), oracle.as_matrix()[0], atol=1e-7)
     assert math.isclose(sum(v * v for v in got), 1.0, abs_tol=1e-12)
+
+
+def test_a_publisher_inventing_frames_is_held_at_max_frames(monkeypatch):
+    from rover_web.tf import buffer as module
+
+    monkeypatch.setattr(module, "MAX_FRAMES", 50)
+    buf = TfBuffer()
+    for i in range(80):
+        buf.set_transform("map", f"f{i}", (0, 0, 0), (0, 0, 0, 1), 0, static=True)
+    assert len(buf.frames(now_ns=0)["frames"]) == 51  # 50 children and map
+    assert buf.rejected["too_many_frames"] == 30
+    assert buf.set_transform("map", "f3", (1, 0, 0), (0, 0, 0, 1), 0, static=True)  # known frames still update
