@@ -46,6 +46,8 @@ def _init_robot(rover: Rover, msgs, missing: str | None) -> None:
     runtime = rover.runtime
     for kind, qos in (("dynamic", msgs.DYNAMIC_QOS), ("static", msgs.STATIC_QOS)):
         static = kind == "static"
+        # /tf's age in /api/status says whether the robot's frames move; /tf_static is sent once
+        # per broadcaster, and would only ever read as stale there.
         runtime.subscribe(msgs.TF_MESSAGE, service.topics[kind], lambda raw, s=static: service.on_raw(raw, s),
-                          qos, raw=True, share=True)
+                          qos, raw=True, share=True, track=not static)
     rover.every(TICK_S, service.publish, name="tf-tree")
