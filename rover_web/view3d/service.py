@@ -100,7 +100,8 @@ class View3dService:
 
     def robot(self) -> dict:
         with self._lock:
-            return dict(self._robot, base_frame=self.base_frame, tf=self.tf is not None and not self.tf_missing,
+            return dict(self._robot, base_frame=self.base_frame, map_frame=self.map_frame,
+                        odom_frame=self.odom_frame, tf=self.tf is not None and not self.tf_missing,
                         tf_missing=self.tf_missing,
                         pose_hz=self.pose_hz, cloud_topic=self.cloud_topic or None,
                         markers_topic=self.markers_topic or None, markers_skipped=dict(self.markers_skipped),

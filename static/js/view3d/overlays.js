@@ -115,7 +115,7 @@ export class Overlays {
   }
 
   place(poses, robotAt) {
-    const inMap = poses.inFixed('map');
+    const inMap = poses.inFixed(this.mapFrame || 'map');
     this.map.visible = Boolean(inMap);
     if (inMap) { this.map.matrix.copy(inMap); this.map.matrixWorldNeedsUpdate = true; }
     // ENU is anchored where the robot was at the first fix heard by this page (x east, y north: REP 103's

@@ -15,6 +15,7 @@ export class Poses {
     this.frames = {};      // name -> pose in base, or null
     this.base = 'base_link';
     this.fixed = 'base_link';
+    this.aliases = {};     // the card's 'map' and 'odom': the robot's own names for them (settings)
   }
 
   update(message) {
@@ -23,7 +24,7 @@ export class Poses {
   }
 
   // The fixed frame as the operator chose it; 'robot' is the base frame.
-  fixedName() { return this.fixed === 'robot' ? this.base : this.fixed; }
+  fixedName() { return this.fixed === 'robot' ? this.base : (this.aliases[this.fixed] || this.fixed); }
 
   // inverse(T_base_fixed), or null while TF does not connect the fixed frame to the base.
   fixedInverse() {

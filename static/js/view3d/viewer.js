@@ -91,6 +91,8 @@ export class Viewer {
     this.robotSeq = description.seq || 0;
     this.description = description;
     this.poses.base = description.base_frame || this.poses.base;
+    this.poses.aliases = { map: description.map_frame || 'map', odom: description.odom_frame || 'odom' };
+    this.overlays.mapFrame = description.map_frame || 'map';
     this.updateCloud();  // the cloud needs only its topic, not a good model
     if (description.state === 'waiting') { this.status(description.message, 'waiting'); return; }
     if (description.state === 'error') { this.status(`URDF refused: ${description.error.message}`, 'error'); return; }
