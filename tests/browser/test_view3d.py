@@ -343,3 +343,34 @@ def test_follow_the_robot_and_orbit_by_touch(scene, page):
     after = page.evaluate(camera)
     assert after != pytest.approx(before, abs=1e-3)
     assert page.evaluate(target)[:2] == pytest.approx([5.0, -2.0], abs=1e-3)  # still about the robot
+
+
+def test_the_page_and_the_card_keep_the_content_security_policy(live_server_factory, browser, tmp_path, monkeypatch):
+    """With the policy enforced (no bypass): the model, its package mesh, the text sprites and the card."""
+    import requests
+
+    from tests.browser.test_csp import RECORD_VIOLATIONS
+    from tests.conftest import PageWatch
+
+    monkeypatch.setenv("AMENT_PREFIX_PATH", str(ament_prefix(tmp_path)))
+    urdf = tmp_path / "robot.urdf"
+    urdf.write_text(ROBOT_URDF)
+    server = live_server_factory(ROVER_WEB_URDF_FILE=str(urdf))
+    made = requests.post(server.url + "/api/layouts", timeout=5, json={
+        "version": 1, "name": "3D", "cards": [{"type": "view3d", "x": 0, "y": 0, "w": 6, "h": 6}]})
+    assert requests.put(server.url + "/api/me/layout", json={"id": made.json()["id"]}, timeout=5).status_code == 200
+    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    context.add_init_script(RECORD_VIOLATIONS)
+    try:
+        page = context.new_page()
+        watch = PageWatch(page)
+        for path, stage in (("/3d", "#view3d"), ("/", "[data-view3d-stage]")):
+            page.goto(server.url + path)
+            page.wait_for_selector(f"{stage}[data-links='3'][data-mesh-errors='0']", timeout=20000)
+            if path == "/3d":
+                page.check("[data-layer='tf']")  # frame names: text drawn into canvas textures
+            page.wait_for_load_state("networkidle")
+            assert page.evaluate("window.__csp") == [], path
+        assert watch.console_errors == [] and watch.offhost == []
+    finally:
+        context.close()
