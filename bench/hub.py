@@ -130,7 +130,7 @@ def main() -> None:
 
     tmp = tempfile.TemporaryDirectory(prefix="rover_web-bench-hub-")
     key_file = os.path.join(tmp.name, "fleet.key")
-    with open(key_file, "w") as fh:
+    with open(os.open(key_file, os.O_WRONLY | os.O_CREAT, 0o600), "w") as fh:  # the hub refuses a looser key
         fh.write(os.urandom(32).hex())
     endpoint = f"tcp/127.0.0.1:{free_port()}"
     zrouter = None

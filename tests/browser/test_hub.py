@@ -72,6 +72,7 @@ class LightRobot:
 def hub(app_factory, tmp_path):
     key = tmp_path / "fleet.key"
     key.write_bytes(KEY)
+    key.chmod(0o600)
     endpoint = f"tcp/127.0.0.1:{free_port()}"
     app = app_factory(ROVER_WEB_HUB=True, ROVER_WEB_ZENOH_MODE="peer", ROVER_WEB_ZENOH_LISTEN=[endpoint],
                       ROVER_WEB_FLEET_KEY_FILE=str(key))
