@@ -17,22 +17,12 @@ topics the features track (never one a person types), route templates (never pat
 
 from __future__ import annotations
 
-from flask import Blueprint, Flask, Response, current_app
-from prometheus_client import CONTENT_TYPE_LATEST, CollectorRegistry, ProcessCollector, generate_latest
+from flask import Flask
+from prometheus_client import CollectorRegistry, ProcessCollector
 
 from .http import RequestCounter
 from .process import ThreadsCollector
-
-EXTENSION = "rover_web_metrics"
-
-bp = Blueprint("metrics", __name__)
-
-
-@bp.get("/metrics")
-def metrics():
-    registry = current_app.extensions[EXTENSION]
-    return Response(generate_latest(registry), mimetype=CONTENT_TYPE_LATEST.split(";")[0],
-                    headers={"Content-Type": CONTENT_TYPE_LATEST, "Cache-Control": "no-store"})
+from .routes import EXTENSION, bp
 
 
 def _registry(app: Flask, *collectors) -> CollectorRegistry | None:
