@@ -136,6 +136,7 @@ class Directory:
                 return False  # an old one, replayed or overtaken
             self._note_estop(heard, opened["summary"])
             heard.summary, heard.sent, heard.received = opened["summary"], sent, self._clock()
+            self._moved(heard, heard.received)
         return True
 
     def _on_alive(self, sample) -> None:
@@ -147,9 +148,11 @@ class Directory:
             heard = self._get(name)
             if heard is None:
                 return
+            now = self._clock()
             if alive and not heard.alive:
-                heard.alive_since = self._clock()
+                heard.alive_since = now
             heard.alive = alive
+            self._moved(heard, now)
         log.info("hub: robot %s %s", name, "present" if alive else "gone (its liveliness token ended)")
 
     def _get(self, name: str) -> _Heard | None:
@@ -181,17 +184,24 @@ class Directory:
             return "waiting"
         return "lost"
 
+    def _moved(self, heard: _Heard, now: float) -> bool:
+        """Note a change of state for the history; called with the lock held, on each arrival (a
+        state may last less than a sweep: waiting for 50 ms) and by the sweep (for the timeouts)."""
+        state = self._state(heard, now)
+        if state == heard.state:
+            return False
+        heard.state, heard.since = state, now
+        self._events.append((heard.name, state, {}))
+        return True
+
     def sweep(self) -> list[tuple[str, str, dict]]:
         """Each robot's state brought up to date: the changes (and what arrived meanwhile) for the
         history; robots lost for ROVER_WEB_FLEET_FORGET_AFTER_S forgotten."""
         now = self._clock()
         with self._lock:
             for heard in list(self._robots.values()):
-                state = self._state(heard, now)
-                if state != heard.state:
-                    heard.state, heard.since = state, now
-                    self._events.append((heard.name, state, {}))
-                elif state == "lost" and now - heard.since >= self.forget_after_s:
+                if not self._moved(heard, now) and heard.state == "lost" \
+                        and now - heard.since >= self.forget_after_s:
                     del self._robots[heard.name]
                     self.forgotten_total += 1
                     self.forgotten.appendleft({"name": heard.name, "at": round(self._wall(), 3)})
@@ -225,8 +235,10 @@ class Directory:
                 line = {**UNHEARD, "title": heard.name, **(heard.summary or {}), "name": heard.name,
                         "heard": state, "alive": heard.alive,
                         "summary_age_s": None if age is None else round(age, 3),
-                        "forget_in_s": round(max(0.0, self.forget_after_s - (now - heard.since)))
-                        if state == "lost" and heard.state == "lost" else None}
+                        "forget_in_s": None}
+                if state == "lost":  # swept as lost already, or about to be at the next sweep
+                    lost_for = now - heard.since if heard.state == "lost" else 0.0
+                    line["forget_in_s"] = round(max(0.0, self.forget_after_s - lost_for))
                 line["url"] = web_url(line.get("url"))
                 lines.append(line)
         return lines

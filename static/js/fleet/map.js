@@ -1,9 +1,12 @@
 // The fleet's GPS map, shared by the fleet page (fleet.js: the robots of one rover_web) and the hub's
-// page (hub.js: robots heard over Zenoh): one marker per robot with a position, each a link to its
+// page (hub/page.js: robots heard over Zenoh): one marker per robot with a position, each a link to its
 // own rover_web, framed until the operator moves the map. The page gives it GET /api/robots's robots
 // on each poll. A robot the hub has lost (`heard: 'lost'`) stays where it was last seen, dimmed.
 // Untrusted text (titles) only ever goes through textContent; a URL is followed only if http(s)
-// (a path on this server is too).
+// (a path on this server is too). With many robots (a hub of 100) markers must not hide each other:
+// markers closer on screen than a dot are spread on a small ring around their common point (each
+// still opens its own robot), and past CROWDED markers the names show only on hover or focus.
+// A robot the hub forgot leaves the map with the list.
 import { createGpsMap, fmtLatLng } from '../gps_map.js';
 
 // 'engaged', 'released', or 'unknown' (a robot the hub has heard no summary from yet).
@@ -62,6 +65,9 @@ function showOnMarker(node, robot) {
 // The map in `container` (its data-config: the server's map config), or null when this browser
 // cannot show one: then `note` says so and the page's table goes on alone. render(robots) places
 // every robot; robots given before the map has loaded are placed once it has.
+const CROWDED = 20;  // markers beyond which names are shown on hover and focus only
+const CELL_PX = 22;  // markers whose dots fall in one cell of this size are spread apart
+
 export function createFleetMap(container, note) {
   const markers = new Map();  // robot name -> maplibregl.Marker
   let userMoved = false;  // once the operator pans or zooms, the map stops framing the robots itself
@@ -99,11 +105,39 @@ export function createFleetMap(container, note) {
     map.fitBounds(bounds, { padding, maxZoom: 17, duration: 0 });
   }
 
+  // Dots that would overlap on screen: each group's members on a ring around the group's first.
+  function spread() {
+    const cells = new Map();
+    for (const [name, marker] of markers) {
+      const p = map.project(marker.getLngLat());
+      const cellKey = `${Math.round(p.x / CELL_PX)},${Math.round(p.y / CELL_PX)}`;
+      if (!cells.has(cellKey)) cells.set(cellKey, []);
+      cells.get(cellKey).push([name, marker]);
+    }
+    for (const group of cells.values()) {
+      group.sort((a, b) => (a[0] < b[0] ? -1 : 1));
+      const radius = group.length > 1 ? Math.max(CELL_PX, (group.length * CELL_PX) / (2 * Math.PI)) : 0;
+      group.forEach(([, marker], i) => {
+        const angle = (2 * Math.PI * i) / group.length;
+        const dx = radius ? Math.round(radius * Math.cos(angle)) : 0;
+        const dy = radius ? Math.round(radius * Math.sin(angle)) : 0;
+        marker.setOffset([-9 + dx, dy]);
+        marker.getElement().dataset.spread = radius ? 'yes' : 'no';
+      });
+    }
+    container.classList.toggle('fleet-crowded', markers.size > CROWDED);
+  }
+
   function render(robots) {
     latest = robots;
     if (!ready) return;
+    const names = new Set(robots.map((r) => r.name));
+    for (const [name, marker] of markers) {
+      if (!names.has(name)) { marker.remove(); markers.delete(name); }  // forgotten by the hub
+    }
     for (const robot of robots) place(robot);
     frame(robots);
+    spread();
   }
 
   try {
@@ -118,5 +152,6 @@ export function createFleetMap(container, note) {
   for (const start of ['dragstart', 'zoomstart']) {
     map.on(start, (e) => { if (e.originalEvent) userMoved = true; });
   }
+  map.on('zoomend', () => { if (ready) spread(); });
   return { map, render };
 }
