@@ -4,8 +4,8 @@
 // on each poll. A robot the hub has lost (`heard: 'lost'`) stays where it was last seen, dimmed.
 // Untrusted text (titles) only ever goes through textContent; a URL is followed only if http(s)
 // (a path on this server is too). With many robots (a hub of 100) markers must not hide each other:
-// markers closer on screen than a dot are spread on a small ring around their common point (each
-// still opens its own robot), and past CROWDED markers the names show only on hover or focus.
+// a marker whose dot would cover another's moves to the nearest free place on rings around its
+// point (each still opens its own robot), and past CROWDED markers the names show only on hover or focus.
 // A robot the hub forgot leaves the map with the list.
 import { createGpsMap, fmtLatLng } from '../gps_map.js';
 
@@ -66,7 +66,7 @@ function showOnMarker(node, robot) {
 // cannot show one: then `note` says so and the page's table goes on alone. render(robots) places
 // every robot; robots given before the map has loaded are placed once it has.
 const CROWDED = 20;  // markers beyond which names are shown on hover and focus only
-const CELL_PX = 22;  // markers whose dots fall in one cell of this size are spread apart
+const APART_PX = 20;  // dots (14 px when crowded, 18 px else) kept at least this far apart
 
 export function createFleetMap(container, note) {
   const markers = new Map();  // robot name -> maplibregl.Marker
@@ -105,25 +105,28 @@ export function createFleetMap(container, note) {
     map.fitBounds(bounds, { padding, maxZoom: 17, duration: 0 });
   }
 
-  // Dots that would overlap on screen: each group's members on a ring around the group's first.
+  // Dots that would overlap on screen: each marker, in name order, keeps its own point if it is free,
+  // else takes the nearest free one on rings around it (6 on the first, 12 on the second, ...).
   function spread() {
-    const cells = new Map();
-    for (const [name, marker] of markers) {
+    const placed = [];
+    const free = (x, y) => placed.every(([px, py]) => Math.hypot(px - x, py - y) >= APART_PX);
+    for (const name of [...markers.keys()].sort()) {
+      const marker = markers.get(name);
       const p = map.project(marker.getLngLat());
-      const cellKey = `${Math.round(p.x / CELL_PX)},${Math.round(p.y / CELL_PX)}`;
-      if (!cells.has(cellKey)) cells.set(cellKey, []);
-      cells.get(cellKey).push([name, marker]);
-    }
-    for (const group of cells.values()) {
-      group.sort((a, b) => (a[0] < b[0] ? -1 : 1));
-      const radius = group.length > 1 ? Math.max(CELL_PX, (group.length * CELL_PX) / (2 * Math.PI)) : 0;
-      group.forEach(([, marker], i) => {
-        const angle = (2 * Math.PI * i) / group.length;
-        const dx = radius ? Math.round(radius * Math.cos(angle)) : 0;
-        const dy = radius ? Math.round(radius * Math.sin(angle)) : 0;
-        marker.setOffset([-9 + dx, dy]);
-        marker.getElement().dataset.spread = radius ? 'yes' : 'no';
-      });
+      let at = [p.x, p.y];
+      for (let ring = 1; !free(...at) && ring < 12; ring += 1) {
+        const count = 6 * ring;
+        for (let i = 0; i < count; i += 1) {
+          const angle = (2 * Math.PI * i) / count;
+          const candidate = [p.x + ring * APART_PX * Math.cos(angle), p.y + ring * APART_PX * Math.sin(angle)];
+          if (free(...candidate)) { at = candidate; break; }
+        }
+      }
+      placed.push(at);
+      const dx = Math.round(at[0] - p.x);
+      const dy = Math.round(at[1] - p.y);
+      marker.setOffset([-9 + dx, dy]);
+      marker.getElement().dataset.spread = dx || dy ? 'yes' : 'no';
     }
     container.classList.toggle('fleet-crowded', markers.size > CROWDED);
   }
