@@ -151,7 +151,8 @@ def test_the_hub_map_shows_a_robot_where_it_is_links_it_and_dims_it_once_lost(hu
 
 class Crowd:
     """Robots r00..r{n-1} of fleet `fleet` from one Zenoh session (a token and a summary each, every
-    0.5 s), half of them at one spot: the page must keep every marker visible and the table usable."""
+    0.5 s), half of them at one spot, the others 40 m apart on a line: the page must keep every marker
+    visible and the table usable."""
 
     def __init__(self, endpoint: str, n: int):
         import zenoh
@@ -176,7 +177,7 @@ class Crowd:
             for i, name in enumerate(self.names):
                 position = ALPHA_AT if i % 2 else {"lng": ALPHA_AT["lng"] + 0.0004 * i, "lat": ALPHA_AT["lat"]}
                 summary = {"title": name, "url": None, "link": "ok", "mode": "idle", "estop": {"engaged": False},
-                           "battery": {"percent": 90.0 - i, "voltage": None}, "position": position, "alerts": []}
+                           "battery": {"percent": 90.0 - i / 2, "voltage": None}, "position": position, "alerts": []}
                 self.publishers[name].put(signing.signed_summary(KEY, "fleet", name, seq, summary))
             if self.done.wait(0.5):
                 return
@@ -189,18 +190,18 @@ class Crowd:
         self.session.close()
 
 
-def test_many_robots_a_sortable_filterable_table_markers_apart_and_a_robot_s_history(hub, strict_page):
+def test_a_hundred_robots_a_sortable_filterable_table_markers_apart_and_a_robot_s_history(hub, strict_page):
     url, robot = hub
-    crowd = Crowd(robot.endpoint, 30)
+    crowd = Crowd(robot.endpoint, 100)
     page = strict_page
     try:
         page.goto(url + "/robots")
-        page.wait_for_function("document.querySelectorAll('#hub-table tbody tr[data-heard=\"live\"]').length === 31",
+        page.wait_for_function("document.querySelectorAll('#hub-table tbody tr[data-heard=\"live\"]').length === 101",
                                timeout=15000)
-        assert "31 robots: 31 live, 0 waiting, 0 lost" in page.inner_text("#hub-counts")
-        # Sorted by battery: r29 (61 %) first, then ascending; again: descending.
+        assert "101 robots: 101 live, 0 waiting, 0 lost" in page.inner_text("#hub-counts")
+        # Sorted by battery: r99 (40.5 %) first, then ascending; again: descending.
         page.click("button.hub-sort[data-sort='battery']")
-        page.wait_for_function("document.querySelector('#hub-table tbody tr').dataset.robot === 'r29'")
+        page.wait_for_function("document.querySelector('#hub-table tbody tr').dataset.robot === 'r99'")
         page.click("button.hub-sort[data-sort='battery']")
         page.wait_for_function("document.querySelector('#hub-table tbody tr').dataset.robot === 'r00'")
         assert page.get_attribute("#hub-table th:has(button[data-sort='battery'])", "aria-sort") == "descending"
@@ -208,9 +209,9 @@ def test_many_robots_a_sortable_filterable_table_markers_apart_and_a_robot_s_his
         page.wait_for_function("document.querySelectorAll('#hub-table tbody tr').length === 1")
         assert page.locator("#hub-table tbody tr").get_attribute("data-robot") == "r07"
         assert "1 shown" in page.inner_text("#hub-counts")
-        # Markers: 15 robots share one spot, and not one dot hides another.
+        # Markers: 50 robots share one spot, and not one dot hides another.
         page.wait_for_selector("#hub-map[data-ready='yes']", timeout=10000)
-        page.wait_for_function("document.querySelectorAll('.fleet-marker').length === 30", timeout=10000)
+        page.wait_for_function("document.querySelectorAll('.fleet-marker').length === 100", timeout=10000)
         assert "fleet-crowded" in page.get_attribute("#hub-map", "class")
         boxes = page.evaluate("""() => [...document.querySelectorAll('.fleet-marker-dot')]
             .map((d) => d.getBoundingClientRect()).map((r) => [r.x, r.y, r.width, r.height])""")
