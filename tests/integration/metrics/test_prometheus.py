@@ -40,6 +40,14 @@ def test_the_shipped_rules_pass_promtool():
     assert "SUCCESS" in result.stdout
 
 
+def test_the_rules_fire_and_stay_quiet_as_written_on_synthetic_series():
+    """promtool's rule tests (alerts_test.yml): the shipped `for:` durations, the thresholds, the
+    labels and annotations, for battery, e-stop, silent topic, recording stopped by a limit, lost."""
+    tests = Path(__file__).with_name("alerts_test.yml")
+    result = subprocess.run([PROMTOOL, "test", "rules", str(tests)], capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
 def _fast_rules(path: Path) -> Path:
     rules = yaml.safe_load(RULES.read_text())
     for group in rules["groups"]:
