@@ -31,7 +31,7 @@ from collections import deque
 from collections.abc import Callable
 
 from rover_web.zenoh_link import signing
-from rover_web.zenoh_link.session import ROOT_KEY, robot_of
+from rover_web.zenoh_link.session import NAME, ROOT_KEY, robot_of
 
 log = logging.getLogger(__name__)
 
@@ -159,7 +159,9 @@ class Directory:
         """The robot's entry, made on first hearing (within MAX_ROBOTS); called with the lock held."""
         heard = self._robots.get(name)
         if heard is None:
-            if len(self._robots) >= MAX_ROBOTS:
+            # A robot's name is a-z 0-9 _ (zenoh_link/session.py): a token under another is nobody's,
+            # and never becomes a page's text or a metric's label.
+            if len(self._robots) >= MAX_ROBOTS or not NAME.match(name):
                 return None
             heard = self._robots[name] = _Heard(name, self._clock())
             self._events.append((name, "found", {}))

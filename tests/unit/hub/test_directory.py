@@ -148,6 +148,10 @@ def test_tokens_alone_cannot_grow_the_list_without_bound(monkeypatch):
     for i in range(20):
         alive(d, f"r{i}", "PUT")
     assert len(d.robots()) == 5
+    d, _ = directory()
+    alive(d, "x" * 40, "PUT")  # not a robot's name (at most 32 of a-z 0-9 _): nobody
+    alive(d, "Évil<b>", "PUT")
+    assert d.robots() == []
 
 
 def test_a_robot_lost_long_enough_is_forgotten_and_the_sweep_tells_the_history():
