@@ -107,11 +107,11 @@ def test_an_alert_fires_when_the_battery_is_low_and_resolves_when_it_recovers(tm
             ],
         }
         (tmp_path / "prometheus.yml").write_text(yaml.safe_dump(config))
-        log = open(tmp_path / "prometheus.log", "w")
-        prometheus = subprocess.Popen([PROMETHEUS, f"--config.file={tmp_path / 'prometheus.yml'}",
-                                       f"--storage.tsdb.path={tmp_path / 'tsdb'}",
-                                       f"--web.listen-address=127.0.0.1:{prom_port}"],
-                                      stdout=log, stderr=subprocess.STDOUT)
+        with open(tmp_path / "prometheus.log", "w") as log:  # the child keeps its own descriptor
+            prometheus = subprocess.Popen([PROMETHEUS, f"--config.file={tmp_path / 'prometheus.yml'}",
+                                           f"--storage.tsdb.path={tmp_path / 'tsdb'}",
+                                           f"--web.listen-address=127.0.0.1:{prom_port}"],
+                                          stdout=log, stderr=subprocess.STDOUT)
         wait_until(lambda: _ready(prom_url), timeout=15, what="Prometheus ready")
         wait_until(lambda: {t["labels"]["job"]: t["health"] for t in requests.get(
             f"{prom_url}/api/v1/targets", timeout=5).json()["data"]["activeTargets"]} ==
