@@ -46,8 +46,9 @@ def load_key(path: str | None) -> bytes:
     in a file only its owner may read and write."""
     if not path:
         raise ConfigError("ROVER_WEB_FLEET_KEY_FILE: the Zenoh link needs the fleet's shared key to sign and check "
-                          "its messages: write 32+ random bytes to a file (python -c \"import secrets; "
-                          "print(secrets.token_hex(32))\" > fleet.key) on the hub and every robot, and name it here")
+                          "its messages: write 32+ random bytes to a file only you can read ((umask 077; python -c "
+                          "\"import secrets; print(secrets.token_hex(32))\" > fleet.key)) on the hub and every "
+                          "robot, and name it here")
     try:
         mode = stat.S_IMODE(os.stat(path).st_mode)
         key = Path(path).read_bytes().strip()
