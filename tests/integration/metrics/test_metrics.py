@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import random
 import string
+import time
 
 import pytest
 from prometheus_client.parser import text_string_to_metric_families
@@ -95,3 +96,33 @@ def test_a_robot_s_own_address_is_derived_when_it_has_no_public_url(settings, ur
 
     assert own_url({"ROVER_WEB_PUBLIC_URL": None, "ROVER_WEB_PORT": 5000, "ROVER_WEB_TLS_CERT": None,
                     **settings}) == url
+
+
+def test_what_the_features_count_moves_in_the_scrape(app_factory, tmp_path):
+    """The collectors read the features' own counters: a goal refused by the geofence, an e-stop engaged
+    and released, a request's route and status."""
+    from tests.support.geofence_helpers import FENCE, INSIDE, OUTSIDE
+
+    client = app_factory(ROVER_WEB_MAP_TILES=str(tmp_path / "no-tiles")).test_client()
+
+    def scrape() -> dict:
+        return families(client.get("/metrics").get_data(as_text=True))
+
+    assert scrape()["rover_web_geofence_refused"].samples[0].value == 0
+    assert client.put("/api/geofence", json=FENCE).status_code == 200
+    assert client.post("/api/waypoints", json={"lng": OUTSIDE[0], "lat": OUTSIDE[1]}).status_code == 422
+    assert client.post("/api/waypoints", json={"lng": OUTSIDE[0], "lat": OUTSIDE[1]}).status_code == 422
+    assert client.post("/api/waypoints", json={"lng": INSIDE[0], "lat": INSIDE[1]}).status_code in (200, 201)
+    found = scrape()
+    assert [s.value for s in found["rover_web_geofence_refused"].samples if s.name.endswith("_total")] == [2]
+    refused = samples(found["rover_web_http_requests"], route="/api/waypoints", method="POST", status="422")
+    assert refused[0].value == 2
+    client.post("/api/estop", json={"engaged": True})
+    found = scrape()
+    assert found["rover_web_estop_engaged"].samples[0].value == 1
+    assert abs(found["rover_web_estop_engaged_since_seconds"].samples[0].value - time.time()) < 5
+    client.post("/api/estop", json={"engaged": False})
+    found = scrape()
+    assert found["rover_web_estop_engaged"].samples[0].value == 0
+    assert not found.get("rover_web_estop_engaged_since_seconds") or \
+        not found["rover_web_estop_engaged_since_seconds"].samples
