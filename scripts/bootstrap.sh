@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Install everything rover_web needs into .venv (and, with --browser, the Debian packages the
-# tests need: chromium for the browser tests, faketime for the wall-clock jump test).
+# tests need: chromium for the browser tests, faketime for the wall-clock jump test, prometheus
+# and promtool for the alerting rules).
 # Safe to run again: it only installs what is missing or changed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -37,8 +38,9 @@ fi
 # (skipped when a sourced ROS 2 install has them, and while interfaces/ is unchanged).
 scripts/build_interfaces.sh .venv
 
-if (( want_browser )) && { [[ ! -x /usr/bin/chromium ]] || [[ ! -e /usr/lib/x86_64-linux-gnu/faketime/libfaketimeMT.so.1 ]]; }; then
-  echo "== installing Debian's chromium and faketime for the tests"
+if (( want_browser )) && { [[ ! -x /usr/bin/chromium ]] || [[ ! -e /usr/lib/x86_64-linux-gnu/faketime/libfaketimeMT.so.1 ]] \
+                           || [[ ! -x /usr/bin/prometheus ]] || [[ ! -x /usr/bin/promtool ]]; }; then
+  echo "== installing Debian's chromium, faketime and prometheus for the tests"
   sudo_cmd=()
   [[ $(id -u) -ne 0 ]] && sudo_cmd=(sudo)
   "${sudo_cmd[@]}" apt-get update -q
