@@ -36,8 +36,8 @@ from .reading import Refused
 MIB = 1 << 20
 CHUNK_MAX = 48 * MIB  # a 4K rgb8 frame is 25 MB; rover_web writes 1 MB chunks
 MESSAGE_MAX = 48 * MIB
-READ_MIN = 1 << 30
-READ_RATIO = 32  # lz4 on camera frames and telemetry: 2-10x; a sim's flat frames more, a bomb thousands
+READ_MIN = 512 * MIB
+READ_RATIO = 64  # lz4 on camera frames and telemetry: 2-10x; the simulator's bars ~30x; a bomb thousands
 TIME_S = 20.0
 SCHEMA_MAX = 256 * 1024  # rosbag2's texts: Odometry 5 KB, the largest Nav2 action ~40 KB
 SCHEMA_FIELDS = 2000  # Odometry's full text has 32; the parser's duplicate check is quadratic in this
@@ -102,7 +102,7 @@ def _refuse_chunk(declared: int, held: str) -> TooCostly:
                                         f"(it declares {declared} bytes)")
 
 
-def decompress(compression: str, data: bytes, declared: int) -> bytes:
+def decompress(compression: str, data: bytes, declared: int) -> bytes | bytearray:
     """The chunk's content, never more than min(declared, CHUNK_MAX) bytes made."""
     if declared > CHUNK_MAX:
         raise _refuse_chunk(declared, f"declares {declared // MIB} MB")
@@ -114,16 +114,20 @@ def decompress(compression: str, data: bytes, declared: int) -> bytes:
     if compression == "zstd":
         import zstandard
 
-        out = bytearray()
+        out = bytearray(most + 1)  # one buffer, filled in place: one byte more than declared says "more"
+        view = memoryview(out)
+        filled = 0
         with zstandard.ZstdDecompressor().stream_reader(data, read_across_frames=True) as reader:
-            while True:
-                block = reader.read(min(_BLOCK, most + 1 - len(out)))
-                if not block:
+            while filled <= most:
+                n = reader.readinto(view[filled:])
+                if not n:
                     break
-                out += block
-                if len(out) > most:
-                    raise _refuse_chunk(declared, "holds more than it declares")
-        return bytes(out)
+                filled += n
+        view.release()
+        if filled > most:
+            raise _refuse_chunk(declared, "holds more than it declares")
+        del out[filled:]
+        return out
     if compression == "lz4":
         import lz4.frame
 

@@ -157,13 +157,11 @@ AMPLIFYING_CHANNEL = Channel(id=1, topic="/odom", message_encoding="cdr", schema
 
 
 def amplification(path: Path, length: int = 8 * MIB, copies: int = 1) -> Path:
-    chunks = []
-    for i in range(copies):
-        message = _message(t_ns=T0_NS + i * 1_000_000, data=empty_array_message(length), sequence=i)
-        chunks.append(Chunk(compression="zstd", data=_zstd_of(message, 0), message_start_time=T0_NS + i * 1_000_000,
-                            message_end_time=T0_NS + i * 1_000_000, uncompressed_crc=0,
-                            uncompressed_size=len(message)))
-    return _plain(path, chunks, AMPLIFYING_SCHEMA, AMPLIFYING_CHANNEL)
+    """`copies` chunks of the one message (the same bytes, the same time: the timeline's 5,000)."""
+    message = _message(data=empty_array_message(length))
+    chunk = Chunk(compression="zstd", data=_zstd_of(message, 0), message_start_time=T0_NS, message_end_time=T0_NS,
+                  uncompressed_crc=0, uncompressed_size=len(message))
+    return _plain(path, [chunk] * copies, AMPLIFYING_SCHEMA, AMPLIFYING_CHANNEL)
 
 
 def many_fields(path: Path, fields: int = 200_000) -> Path:
