@@ -203,13 +203,15 @@ def worker_figures(folder: Path) -> dict:
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     code = ("import resource, pathlib; resource.setrlimit(resource.RLIMIT_AS, (512 << 20, 512 << 20)); "
-            f"from rover_web.recording.file_index import walk; walk(pathlib.Path({str(small)!r}))")
-    subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT, env={**os.environ, "PYTHONPATH": str(ROOT)})
+            f"from rover_web.recording.file_index import walk; walk(pathlib.Path({str(small)!r})); "
+            "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)")
+    done = subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT, capture_output=True, text=True,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
     spawn_ms = (time.perf_counter() - t0) * 1000
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     r = {"in_process_read_ms": round(in_process_ms, 2), "worker_spawn_read_ms": round(spawn_ms, 1),
          "worker_cpu_s": round((after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime), 3),
-         "worker_peak_rss_mb": round(after.ru_maxrss / 1024, 1)}
+         "worker_peak_rss_mb": round(int(done.stdout.split()[-1]) / 1024, 1)}
     print(f"a read in this process {r['in_process_read_ms']} ms; in a spawned worker (RLIMIT_AS 512 MB) "
           f"{r['worker_spawn_read_ms']} ms wall, {r['worker_cpu_s']} s CPU, peak RSS {r['worker_peak_rss_mb']} MB",
           flush=True)
@@ -223,9 +225,9 @@ def main() -> None:
     args = parser.parse_args()
     print(machine(), "(shared with other sessions: figures from a loaded machine)")
     env = ros_env()
-    results = run_files(env, args.quick)
     with tempfile.TemporaryDirectory() as tmp:
         worker = worker_figures(Path(tmp))
+    results = run_files(env, args.quick)
     markers = run_markers(env, args.markers)
     ok_files = all(r["cpu_s"] < 2 and r["first_rss_growth_mb"] < 100 and r["estop_p99_ms"] < 50 for r in results[1:])
     ok_markers = markers["rss_growth_mb"] < 100 and markers["estop_p99_ms"] < 50 and markers["cpu_after_pct"] < 10
