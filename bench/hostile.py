@@ -97,6 +97,7 @@ def measured(server: Server, action, window_s: float = 3.0) -> dict:
         if first_peak is None:
             time.sleep(0.05)  # one more RSS sample
             first_peak = max(monitor.peak_mb, server.rss_mb())
+        time.sleep(0.25)  # one attacker's file after another, not a flood of uploads (that is the rate limit's)
     cpu1 = server.cpu_seconds()
     m = monitor.stop()
     return {"answer": answer, "runs": runs, "cpu_s": round((cpu1 - cpu0) / runs, 3), "wall_s": round(max(walls), 3),
