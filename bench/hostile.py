@@ -171,8 +171,17 @@ def run_markers(env: dict, markers: int) -> dict:
         fleet.poll(0.5, lambda *a: None)
         rss0, cpu0 = server.rss_mb(), server.cpu_seconds()
         monitor = Monitor(server)
-        pub = start_peer("marker_flood.py", env, "--markers", str(markers), "--times", "3", "--period", "2")
-        fleet.poll(8.0, lambda _tw, _ta, name, data: sizes.append(len(data.get("markers", []))))
+        pub = start_peer("marker_flood.py", env, "--markers", str(markers), "--times", "6", "--period", "2")
+
+        def heard() -> int:
+            layer = requests.get(server.url + "/api/overlays", timeout=10).json()["layers"]["markers"]
+            return layer["received"] + layer["skipped_by_reason"].get("too_large", 0)
+
+        deadline = time.monotonic() + 25  # DDS reassembles a 40 MB sample slowly on a loaded machine
+        while time.monotonic() < deadline and (heard() < 2 or pub.poll() is None):
+            fleet.poll(1.0, lambda _tw, _ta, name, data: sizes.append(len(data.get("markers", []))))
+            if pub.poll() is not None and heard() >= 1:
+                break
         stop_process(pub)
         during_cpu = server.cpu_seconds() - cpu0
         m = monitor.stop()

@@ -47,7 +47,7 @@ MIN_ELEMENT = 4  # bytes: an array of smaller messages is decoded into more obje
 _HEAD = struct.Struct("<BQ")
 _CHUNK_HEAD = struct.Struct("<QQQI")  # start, end, uncompressed size, uncompressed crc
 _MESSAGE_HEAD = struct.Struct("<HIQQ")  # channel, sequence, log time, publish time
-_BLOCK = MIB
+_BLOCK = 2 * MIB
 
 
 class TooCostly(Refused):
@@ -118,8 +118,8 @@ def decompress(compression: str, data: bytes, declared: int) -> bytes | bytearra
         view = memoryview(out)
         filled = 0
         with zstandard.ZstdDecompressor().stream_reader(data, read_across_frames=True) as reader:
-            while filled <= most:
-                n = reader.readinto(view[filled:])
+            while filled <= most:  # a few MB a call: other threads (the e-stop's request) get the GIL between
+                n = reader.readinto(view[filled:filled + _BLOCK])
                 if not n:
                     break
                 filled += n
