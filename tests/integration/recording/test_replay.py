@@ -113,3 +113,12 @@ def test_replay_leaves_motion_and_safety_out_unless_asked(ros_peer, tmp_path):
     peer.wait_for("/e_stop", lambda m: m["data"] is False, timeout=5)
     peer.wait_for("/cmd_vel", lambda m: True, timeout=5)
     peer.wait_for("/nav/cmd", lambda m: True, timeout=5)
+
+
+def test_a_file_over_a_reading_bound_is_refused_before_anything_is_published(tmp_path):
+    from tests.support import hostile_mcap as hostile
+
+    path = hostile.zstd_bomb(tmp_path / "bomb.mcap", held=200 * (1 << 20))  # its one message is in the bomb
+    done = replay(path, "--delay", "0")
+    assert done.returncode == 1, done.stdout
+    assert "Error:" in done.stderr and "chunk" in done.stderr and "replayed" not in done.stdout
