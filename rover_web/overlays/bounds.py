@@ -23,6 +23,7 @@ FOOTPRINT_MAX_BYTES = 16 * KIB  # FOOTPRINT_MAX_POINTS (200) points of 12 bytes
 GRID_OVERHEAD_BYTES = 4 * KIB  # header, frame_id and MapMetaData around the cells
 NS_MAX = 64
 TEXT_MAX = 200
+FRAME_ID_MAX = 256  # a frame name; each marker carries its own into the frame sent to every page
 
 
 def grid_max_bytes(max_cells: int) -> int:
