@@ -11,6 +11,9 @@ a robot listening on the domain, and its /e_stop would release one engaged since
 comes from elsewhere. Left out: the app's own ROVER_WEB_CMD_VEL_TOPIC and ROVER_WEB_ESTOP_TOPIC, any
 topic named cmd_vel*, e_stop or estop, any Twist or TwistStamped, and anything of an action (its
 hidden `/_action/` topics, goal types). Each one left out is said on stderr.
+
+/tf_static goes out transient local, as tf2's static broadcasters publish it (its subscribers match
+nothing else).
 """
 
 from __future__ import annotations
@@ -77,6 +80,13 @@ def init_cli(app: Flask) -> None:
             player.close()
 
 
+STATIC_TF_DEPTH = 100
+
+
+def _static_tf(type_name: str, topic: str) -> bool:
+    return type_name == "tf2_msgs/msg/TFMessage" and topic.rstrip("/").endswith("tf_static")
+
+
 class _Player:
     def __init__(self, domain_id: int | None, rate: float, wanted: set[str], delay: float,
                  motion_topics: tuple[str, ...] | None = None):
@@ -106,7 +116,13 @@ class _Player:
             self._skipped.add(channel.topic)
             return None
         try:
-            publisher = self.ros.publisher(schema.name, channel.topic)
+            if _static_tf(schema.name, channel.topic):
+                # tf2's listeners take /tf_static transient local only: a volatile publisher would
+                # never reach them. Every static message of the file is kept for late joiners, as
+                # each static broadcaster keeps its own.
+                publisher = self.ros.publisher(schema.name, channel.topic, STATIC_TF_DEPTH, latched=True)
+            else:
+                publisher = self.ros.publisher(schema.name, channel.topic)
         except UnknownMessageType as exc:
             click.echo(f"skipping {channel.topic}: {exc}", err=True)
             self._skipped.add(channel.topic)
