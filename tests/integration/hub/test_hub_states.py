@@ -174,7 +174,9 @@ def test_a_robot_with_no_public_url_links_to_its_own_address(rig, tmp_path):
                           what="echo live")
         assert line["url"] == f"http://127.0.0.1:{port}/robots/echo/"
         assert requests.get(line["url"] + "api/robots", timeout=5).json()["current"] == "echo"
-        events = [e["event"] for e in rig.get("/api/robots/echo/history").json()["events"]]
+        # The history is written by the database's committer thread: read it once it has landed.
+        events = wait_until(lambda: (ev := [e["event"] for e in rig.get("/api/robots/echo/history").json()["events"]])
+                            and "live" in ev and ev, timeout=10, what="echo's history")
         assert events[-1] == "found" and "live" in events
     finally:
         robot.stop()
