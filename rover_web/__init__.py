@@ -77,6 +77,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         layouts,
         livemap,
         logs,
+        metrics,
         overlays,
         panels,
         plot,
@@ -136,6 +137,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         recording.init_app(app, fleet)  # last of the features: it records what they publish and do
         fleet_pages.init_app(app, fleet)  # /robots, /api/robots and /robots/<name>/... for every route
         zenoh_link.init_app(fleet)  # last: its summaries read every feature; its stop engages the e-stop
+        metrics.init_app(app, fleet)  # GET /metrics reads every feature at scrape time
     except BaseException:
         # A feature that failed to start may follow others that already started loops and
         # threads: stop them all in order, not just the node under them.

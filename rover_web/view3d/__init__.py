@@ -16,13 +16,18 @@ import logging
 
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
+from rover_web.overlays.bounds import MARKERS_MAX_BYTES, bounded
 from rover_web.tf import TfService
 
 from . import msgs, routes
+from .cloud import MAX_SOURCE_POINTS
 from .service import CHANNELS, View3dService
+from .urdf_model import MAX_URDF_BYTES
 
 log = logging.getLogger(__name__)
 MARKER_EXPIRY_S = 0.5
+DESCRIPTION_MAX_BYTES = MAX_URDF_BYTES + 1024  # the URDF text and the CDR around it
+CLOUD_MAX_BYTES = MAX_SOURCE_POINTS * 32 + 64 * 1024  # 32-byte points (x, y, z, intensity, ring, time...)
 
 
 def init_app(app, fleet: Fleet) -> None:
@@ -39,17 +44,25 @@ def _init_robot(rover: Rover) -> None:
     tf = rover.feature(TfService)  # set up before this feature (create_app)
     service.tf, service.tf_missing = tf.buffer, tf.missing
     runtime = rover.runtime
+    hub = rover.hub
+    # Taken raw and bounded before rclpy deserializes anything (overlays/bounds.py, issue 40); markers
+    # and clouds only while a page shows them. The description is kept regardless: it is latched.
     if service.urdf_file:
         service.load_file()
     elif service.description_topic:
-        runtime.subscribe(msgs.STRING, service.description_topic,
-                          lambda m: service.on_description(msgs.description(m), service.description_topic), "latched")
+        runtime.subscribe(msgs.STRING, service.description_topic, bounded(
+            service.description_counts, DESCRIPTION_MAX_BYTES, msgs.deserializer(msgs.STRING),
+            lambda m: service.on_description(msgs.description(m), service.description_topic)), "latched", raw=True)
     if service.cloud_topic:
-        runtime.subscribe(msgs.POINT_CLOUD2, service.cloud_topic,
-                          lambda m: service.on_cloud(lambda: msgs.point_cloud(m)), "sensor_data")
+        runtime.subscribe(msgs.POINT_CLOUD2, service.cloud_topic, bounded(
+            service.cloud_bound, CLOUD_MAX_BYTES, msgs.deserializer(msgs.POINT_CLOUD2),
+            lambda m: service.on_cloud(lambda: msgs.point_cloud(m)), service.cloud_watched), "sensor_data", raw=True)
     if service.markers_topic:
-        # share: the overlays read the same topic with the same QoS; one subscription serves both
-        runtime.subscribe(msgs.MARKER_ARRAY, service.markers_topic, lambda m: service.on_markers(msgs.markers(m)),
-                          10, share=True, track=not runtime.tracks(service.markers_topic))
+        # A subscription of its own beside the overlays' (theirs keeps x, y and yaw only), deserialized
+        # only while a 3D view is open.
+        runtime.subscribe(msgs.MARKER_ARRAY, service.markers_topic, bounded(
+            service.markers_bound, MARKERS_MAX_BYTES, msgs.deserializer(msgs.MARKER_ARRAY),
+            lambda m: service.on_markers(msgs.markers(m)), lambda: hub.watchers("view3d_markers") > 0),
+            10, raw=True, track=not runtime.tracks(service.markers_topic))
         rover.every(MARKER_EXPIRY_S, service.expire_markers, name="view3d-marker-expiry")
     rover.every(1.0 / service.pose_hz, service.tick, name="view3d-poses")

@@ -23,6 +23,22 @@ log = logging.getLogger(__name__)
 
 CHANNELS = ("view3d", "view3d_robot", "view3d_markers")
 MARKERS_MAX_HZ = 10.0
+CLOUD_WATCHED_S = 5.0  # a cloud is read while a viewer asked for one this recently
+
+
+class Counted:
+    """receive() and skip(reason) for overlays/bounds.py's `bounded`, into a counts dict of ours."""
+
+    def __init__(self, counts: dict, receive: bool = True):
+        self._counts, self._receive = counts, receive
+
+    def receive(self) -> None:
+        if self._receive:
+            self._counts["received"] = self._counts.get("received", 0) + 1
+
+    def skip(self, reason: str) -> None:
+        skipped = self._counts.setdefault("skipped", {})
+        skipped[reason] = skipped.get(reason, 0) + 1
 NAMES_EVERY_S = 1.0
 
 
@@ -54,6 +70,11 @@ class View3dService:
         self._markers = Markers3d()
         self._markers_lock = threading.Lock()
         self.markers_skipped: dict[str, int] = {}  # by reason (markers.py)
+        self._markers_counts: dict = {"skipped": self.markers_skipped}
+        self.markers_bound = Counted(self._markers_counts)
+        self.cloud_bound = Counted(self._cloud_counts)
+        self.description_counts = Counted({}, receive=False)
+        self._cloud_asked_at = -CLOUD_WATCHED_S  # monotonic time of the last cloud request
         self._names: list[str] = []
         self._names_at = 0.0
         self.tf = None  # the tf feature's TfBuffer, set by init_app
@@ -110,8 +131,8 @@ class View3dService:
     # --- poses, once per tick ---
 
     def tick(self) -> None:
-        # No event stream open on this robot: nobody could be shown the poses, so none are looked up.
-        if self.tf is None or self.hub.client_count == 0:
+        # No open stream asked for the poses: nobody could be shown them, so none are looked up.
+        if self.tf is None or self.hub.watchers("view3d") == 0:
             return
         now = time.monotonic()
         if now >= self._names_at:  # the tree's snapshot is the costly part: its names once a second
@@ -178,7 +199,8 @@ class View3dService:
         """The newest frame if its sequence is past `after`, waiting up to wait_s for one; (seq, None) if none.
         The first viewer to ask for a new cloud thins it (once per cloud, for all). `ended`: set (with
         end_waits) when the request's credential is revoked, to stop waiting at once."""
-        deadline = time.monotonic() + wait_s
+        self._cloud_asked_at = time.monotonic()
+        deadline = self._cloud_asked_at + wait_s
         with self._cloud_cond:
             # a restarted server's sequence starts again: a viewer ahead of it gets the newest at once
             while self._cloud_raw is None or after == self._cloud_seq:
@@ -193,6 +215,10 @@ class View3dService:
                 self._cloud_frame = self._thin(raw, seq)
                 self._cloud_frame_seq = seq
             return self._cloud_frame_seq, self._cloud_frame
+
+    def cloud_watched(self) -> bool:
+        """Whether a viewer asked for a cloud lately: the subscription deserializes only then."""
+        return time.monotonic() - self._cloud_asked_at < CLOUD_WATCHED_S
 
     def end_waits(self, ended: threading.Event) -> None:
         """Wake the waiting requests so the one whose `ended` is set returns (its credential ended)."""
