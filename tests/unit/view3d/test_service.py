@@ -90,3 +90,18 @@ def test_a_cloud_is_placed_where_its_frame_was_at_its_stamp(service):
     service.on_cloud(lambda: cloud.Cloud("moving", 99.0, xyz, None, 3))  # past the newest transform
     header, _, _ = cloud.decode(service.cloud_after(1, 1.0)[1])
     assert "odom" not in header.get("at_stamp", {})
+
+
+def test_a_cloud_over_its_bound_or_unwatched_is_never_deserialized(service):
+    from rover_web.overlays.bounds import bounded
+
+    deserialized = []
+    on_raw = bounded(service.cloud_bound, 100, lambda raw: deserialized.append(raw) or raw, lambda m: None,
+                     service.cloud_watched)
+    on_raw(b"x" * 50)                      # nobody asked for a cloud yet
+    assert deserialized == [] and service.cloud_counts()["skipped"] == {}
+    service.cloud_after(0, 0)              # a viewer asks
+    on_raw(b"x" * 500)                     # over the bound: counted, dropped as bytes
+    assert deserialized == [] and service.cloud_counts()["skipped"] == {"too_large": 1}
+    on_raw(b"x" * 50)
+    assert deserialized == [b"x" * 50]
