@@ -88,6 +88,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         teleop,
         tf,
         topics,
+        view3d,
         waypoints,
     )
     from rover_web import fleet as fleet_pages
@@ -124,6 +125,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         panels.init_app(app, fleet)
         livemap.init_app(app, fleet)
         overlays.init_app(app, fleet)  # what the robot senses, on LiveMap
+        view3d.init_app(app, fleet)  # after overlays (it shares their markers subscription) and tf
         camera.init_app(app, fleet)
         topics.init_app(app, graph)
         logs.init_app(app, graph)

@@ -255,6 +255,14 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("FOOTPRINT_TOPIC", "/global_costmap/published_footprint", "optional_topic",
             "geometry_msgs/PolygonStamped footprint drawn on LiveMap; empty: off"),
     Setting("LIVEMAP_TRAIL_S", 60.0, "float", "how far back LiveMap's recent path reaches (s)", 1, 3600),
+    # --- the 3D view (docs/view3d.md) ---
+    Setting("ROBOT_DESCRIPTION_TOPIC", "/robot_description", "optional_topic",
+            "std_msgs/String URDF, transient local, as robot_state_publisher serves it; empty: only URDF_FILE"),
+    Setting("URDF_FILE", None, "optional_str", "a URDF file drawn instead of the description topic's"),
+    Setting("POINTCLOUD_TOPIC", "", "optional_topic",
+            "sensor_msgs/PointCloud2 drawn in the 3D view, thinned on a voxel grid; empty: off"),
+    Setting("POINTCLOUD_MAX_POINTS", 20000, "int", "points a cloud is thinned to for the browser", 100, 200_000),
+    Setting("VIEW3D_POSE_HZ", 10.0, "float", "how often the TF frames' poses go to 3D viewers", 1, 30),
     # --- camera ---
     Setting("CAMERA_TOPIC", "/camera/image_raw", "topic",
             "image topic (sensor_msgs/Image or CompressedImage) the dashboard's camera panel shows first"),

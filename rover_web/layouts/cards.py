@@ -79,6 +79,10 @@ CARDS: dict[str, CardType] = {c.name: c for c in (
     CardType("node", "Node", "cards/node.html", size=(4, 4), help="rover_web's node and its topics"),
     CardType("link", "Link", "cards/link.html", size=(6, 3), min_size=(3, 2),
              help="round trip to the server and the age of the robot's newest message"),
+    # One per layout: each is a WebGL context, and browsers allow a page only a few (about 16).
+    CardType("view3d", "3D view", "cards/view3d.html", channels=("view3d", "view3d_robot", "view3d_markers"),
+             settings=settings({"fixed": {"enum": ["map", "odom", "robot"]}}), size=(6, 6), min_size=(3, 3),
+             help="the robot's model moved by TF, its markers and point cloud"),
 )}
 
 
