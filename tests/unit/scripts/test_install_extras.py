@@ -22,6 +22,10 @@ def installs(tmp_path: Path, script: str, *args: str) -> list[str]:
         (tmp_path / "scripts").mkdir(exist_ok=True)
         shutil.copy(ROOT / "scripts" / name, tmp_path / "scripts" / name)
     shutil.copy(ROOT / "pyproject.toml", tmp_path / "pyproject.toml")
+    # The interface build (scripts/build_interfaces.sh) is not what this test is about: it has a
+    # test of its own (tests/unit/test_interfaces.py); here it only has to be called.
+    (tmp_path / "scripts" / "build_interfaces.sh").write_text('#!/usr/bin/env bash\necho "$0 $*" >> built\n')
+    (tmp_path / "scripts" / "build_interfaces.sh").chmod(0o755)
     venv = tmp_path / ".venv" / "bin"
     venv.mkdir(parents=True, exist_ok=True)
     (venv / "python").write_text(FAKE_PYTHON)
