@@ -2,8 +2,8 @@
 // history from GET /api/plot and growing from the `plot` channel, as on the Plot page (plot.js,
 // which adds series interactively; a card's are fixed by its settings). The server ends a series
 // nobody asked for in a while, so an open card asks again now and then.
-import { api, ApiError } from '../api.js';
-import { on } from '../live.js';
+import { api, ApiError } from '../core/api.js';
+import { on } from '../live/live.js';
 
 const COLOURS = ['#58a6ff', '#e3b341', '#7ee787', '#ff7b72'];
 const KEEP_ALIVE_MS = 10000;

@@ -4,7 +4,7 @@
 // on each poll. A robot the hub has lost (`heard: 'lost'`) stays where it was last seen, dimmed.
 // Untrusted text (titles) only ever goes through textContent; a URL is followed only if http(s)
 // (a path on this server is too).
-import { createGpsMap, fmtLatLng } from '../gps_map.js';
+import { createGpsMap, fmtLatLng } from '../gps/gps_map.js';
 
 // 'engaged', 'released', or 'unknown' (a robot the hub has heard no summary from yet).
 export function estopState(robot) {

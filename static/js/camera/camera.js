@@ -8,11 +8,11 @@
 // the slowest links a snapshot mode polls GET /snapshot instead (camera/snapshots.js), suggested
 // when the stream's rate is very low, and remembered per browser.
 
-import { api, at } from './api.js';
-import { playAcked, supported as ackedSupported } from './camera/acked_stream.js';
-import { describe, watchViewer } from './camera/stats.js';
-import { pollSnapshots } from './camera/snapshots.js';
-import { play as playWebRtc, stop as stopWebRtc } from './camera/webrtc.js';
+import { api, at } from '../core/api.js';
+import { playAcked, supported as ackedSupported } from './acked_stream.js';
+import { describe, watchViewer } from './stats.js';
+import { pollSnapshots } from './snapshots.js';
+import { play as playWebRtc, stop as stopWebRtc } from './webrtc.js';
 
 const card = document.getElementById('camera-card');
 const STORAGE_KEY = 'rover_web.camera.topic';

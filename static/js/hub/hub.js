@@ -1,8 +1,8 @@
 // The fleet hub's page (templates/hub.html): polls GET /api/robots once a second while shown, and
 // "Stop all" posts POST /api/estop/all, then shows each robot's answer (engaged, refused, no_answer).
 // Its map is the fleet page's (static/js/fleet/map.js): each robot with a position, dimmed once lost.
-import { api } from './api.js';
-import { createFleetMap, estopState } from './fleet/map.js';
+import { api } from '../core/api.js';
+import { createFleetMap, estopState } from '../fleet/map.js';
 
 const table = document.querySelector('#hub-table tbody');
 const lastStop = document.getElementById('hub-last-stop');

@@ -2,11 +2,11 @@
 // mission list, and the robot's fix with its track. The server owns the mission: every edit is an
 // HTTP call, and what is drawn is whatever the `waypoints` channel (or a fresh GET) says, newest
 // revision wins. Untrusted text (labels) only ever goes through textContent.
-import { api } from './api.js';
-import { on } from './live.js';
-import { attachGeofence } from './geofence_map.js';
-import { createGpsMap, fmtLatLng } from './gps_map.js';
-import { ROBOT_LAYERS, ROBOT_SOURCES, createRobot } from './gps/robot.js';
+import { api } from '../core/api.js';
+import { on } from '../live/live.js';
+import { attachGeofence } from '../geofence/geofence_map.js';
+import { createGpsMap, fmtLatLng } from '../gps/gps_map.js';
+import { ROBOT_LAYERS, ROBOT_SOURCES, createRobot } from '../gps/robot.js';
 
 const el = document.getElementById('wp-map');
 if (el) init(el);

@@ -3,14 +3,14 @@
 // in livemap/: geometry (world <-> pixel <-> screen), view (pan and zoom), draw (the canvas),
 // readout (the text and window.liveMapState), input (pointer, wheel, keys) and network (goals and
 // live data). The page renders with its data in #livemap-data; the event stream keeps it current.
-import { geometryOf, pixelToWorld, screenToWorld, worldToPixel, worldToScreen } from './livemap/geometry.js';
-import { createViewport } from './livemap/view.js';
-import { drawScene } from './livemap/draw.js';
-import { publish, say } from './livemap/readout.js';
-import { attachInput } from './livemap/input.js';
-import { follow, mapPageUrl, sendGoal } from './livemap/network.js';
-import { POSE_HINT, POSE_MODE, finishPoseGesture } from './livemap/initial_pose.js';
-import { createLayers } from './livemap/layers/layers.js';
+import { geometryOf, pixelToWorld, screenToWorld, worldToPixel, worldToScreen } from './geometry.js';
+import { createViewport } from './view.js';
+import { drawScene } from './draw.js';
+import { publish, say } from './readout.js';
+import { attachInput } from './input.js';
+import { follow, mapPageUrl, sendGoal } from './network.js';
+import { POSE_HINT, POSE_MODE, finishPoseGesture } from './initial_pose.js';
+import { createLayers } from './layers/layers.js';
 
 export { worldToPixel, pixelToWorld };
 

@@ -1,8 +1,8 @@
 // Mission control panels: keeps the server-rendered panels (and the dashboard summary) current
 // from the `panel` and `panel_log` channels, and sends commands. The server decides what is
 // allowed; the page only mirrors it so an operator sees why a button is disabled.
-import { api, ApiError } from './api.js';
-import { on } from './live.js';
+import { api, ApiError } from '../core/api.js';
+import { on } from '../live/live.js';
 
 const LIGHT_TEXT = { green: 'not running', red: 'running', unknown: 'unknown' };
 

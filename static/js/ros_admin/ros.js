@@ -3,7 +3,7 @@
 // their live feedback (one EventSource per running goal) and a cancel button. Buttons this user
 // may not use (a role below admin, read-only mode, a name the deny list refuses) are disabled with
 // the reason as their title; the server decides all the same.
-import { api, ApiError, at } from './api.js';
+import { api, ApiError, at } from '../core/api.js';
 
 const layout = document.querySelector('.ros-layout');
 const writeBlock = layout.dataset.writeBlock || '';

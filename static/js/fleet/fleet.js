@@ -4,8 +4,8 @@
 // and the browser allows only 6 per host — with a few robots the page's own requests (and every
 // other rover_web tab) would queue behind them. A hidden tab stops asking until it is shown again.
 // Untrusted text (titles, operator names) only ever goes through textContent.
-import { api } from './api.js';
-import { createFleetMap, estopState } from './fleet/map.js';
+import { api } from '../core/api.js';
+import { createFleetMap, estopState } from './map.js';
 
 const POLL_MS = 1000;
 const $ = (id) => document.getElementById(id);

@@ -1,8 +1,8 @@
 // Topic browser: the live topic list (`topics` channel) and an echo of the chosen topic
 // (its own EventSource on /api/topics/echo, closed when another topic is chosen or the tab is
 // hidden, so the server removes the subscription when nobody looks).
-import { at, errorFrom } from './api.js';
-import { on } from './live.js';
+import { at, errorFrom } from '../core/api.js';
+import { on } from '../live/live.js';
 
 const body = document.getElementById('topics-body');
 const filter = document.getElementById('topics-filter');

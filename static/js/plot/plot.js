@@ -2,9 +2,9 @@
 // GET /api/plot and then grows from the `plot` channel (new points of every series, ten times a
 // second). All series share one time axis (uPlot.join aligns them). Pause freezes the chart, a
 // drag zooms (and pauses), CSV exports every point this page holds.
-import { api, ApiError } from './api.js';
-import { on } from './live.js';
-import { chartWidth, joined, makeChart, seriesItems } from './plot/chart.js';
+import { api, ApiError } from '../core/api.js';
+import { on } from '../live/live.js';
+import { chartWidth, joined, makeChart, seriesItems } from './chart.js';
 
 const KEEP = 20000;  // points per series kept in the page
 const $ = (id) => document.getElementById(id);

@@ -3,10 +3,10 @@
 // a separate button in the banner an engaged latch shows under the bar, and it asks first in a
 // dialog of the page (<dialog>: focus stays in it, Escape keeps the robot stopped), so neither a
 // double click nor a stray tap can release.
-import { api } from './api.js';
-import { on } from './live.js';
-import { operatorName } from './operator.js';
-import { sendEstopOverSocket } from './teleop_link.js';
+import { api } from '../core/api.js';
+import { on } from '../live/live.js';
+import { operatorName } from '../core/operator.js';
+import { sendEstopOverSocket } from '../teleop/teleop_link.js';
 
 const SOCKET_CONFIRM_MS = 300;
 const box = document.getElementById('estop');

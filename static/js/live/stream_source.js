@@ -4,7 +4,7 @@
 // Opening again (more channels, a silent stream) passes the last event id, so the server replays
 // the ring events (scan_code, panel_log) sent in between instead of losing them; the conflated
 // channels come back as a snapshot either way.
-import { at } from './api.js';
+import { at } from '../core/api.js';
 
 export class Source {
   constructor(onEvent, onTrouble, lastId = '') {

@@ -1,5 +1,5 @@
 // Dashboard thumbnail of the default map: a dot where the robot is, a link to the live map.
-import { on } from './live.js';
+import { on } from '../live/live.js';
 
 const thumb = document.getElementById('livemap-thumb');
 const dot = document.getElementById('livemap-thumb-robot');

@@ -5,7 +5,7 @@
 // periods means the link is stalled even if the socket looks open, so the page says `lost` and
 // replaces the stream. link/honest.js turns the state into <body data-link> and greys live values.
 
-import { markingLive, showLink } from './link/honest.js';
+import { markingLive, showLink } from '../link/honest.js';
 import { openStream } from './shared_stream.js';
 
 const handlers = new Map();

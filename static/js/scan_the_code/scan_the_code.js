@@ -1,7 +1,7 @@
 // Scan the Code panel: boxes, live light tower, detected code, freshness, history.
 // Every string from the robot is set with textContent; colour names become CSS values only when
 // they are one of the configured colours (or black).
-import { on, onServerState } from './live.js';
+import { on, onServerState } from '../live/live.js';
 
 const card = document.getElementById('scan-the-code');
 const TOWER_KEY = 'rover_web.scan_the_code.tower_hidden';

@@ -1,5 +1,5 @@
 // The health bar's error pill: ERROR and FATAL lines on /rosout in the last minute (`rosout_health`).
-import { on } from './live.js';
+import { on } from '../live/live.js';
 
 on('rosout_health', (h) => {
   const pill = document.getElementById('link-errors');

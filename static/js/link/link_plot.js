@@ -2,8 +2,8 @@
 // times a GET /api/ping (browser↔server round trip) and reads the age of the newest message on
 // the link topics from the status; both are plotted in ms over the last 5 minutes (log scale: a
 // 3 ms round trip and a 4 s silence both stay readable).
-import { at } from './api.js';
-import { on } from './live.js';
+import { at } from '../core/api.js';
+import { on } from '../live/live.js';
 
 const KEEP = 300;
 const el = document.getElementById('link-plot');

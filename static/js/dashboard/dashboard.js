@@ -1,4 +1,4 @@
-import { on } from './live.js';
+import { on } from '../live/live.js';
 
 const text = (id, value) => { const el = document.getElementById(id); if (el) el.textContent = value; };
 

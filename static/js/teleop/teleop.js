@@ -6,13 +6,13 @@
 // pagehide and blur. After a stop it did not ask for (deadman, e-stop, takeover), the server sends
 // a new epoch; frames carrying the old one are dropped, so only input sent after that notice moves
 // the robot again.
-import { base } from './api.js';
-import { on } from './live.js';
-import { operatorName, setOperatorName } from './operator.js';
+import { base } from '../core/api.js';
+import { on } from '../live/live.js';
+import { operatorName, setOperatorName } from '../core/operator.js';
 import { startGamepad } from './teleop_gamepad.js';
 import { setEstopSender } from './teleop_link.js';
-import { teleopChannel } from './camera/teleop_channel.js';
-import { linkView } from './teleop/link_view.js';
+import { teleopChannel } from '../camera/teleop_channel.js';
+import { linkView } from './link_view.js';
 
 const card = document.getElementById('teleop-card');
 if (card) start();

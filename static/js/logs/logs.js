@@ -3,8 +3,8 @@
 // server); new lines arrive in batches on the `rosout` channel and are filtered and grouped here
 // the same way; lines are numbered, so a missed batch is noticed and the table re-read. Pause
 // stops the table moving; resume reloads it from the server.
-import { api, ApiError } from './api.js';
-import { on } from './live.js';
+import { api, ApiError } from '../core/api.js';
+import { on } from '../live/live.js';
 
 const LEVELS = { DEBUG: 10, INFO: 20, WARN: 30, ERROR: 40, FATAL: 50 };
 const SHOWN = 200;

@@ -2,9 +2,9 @@
 // every robot's, retried while no answer comes back, like the page's own e-stop. The page's own
 // robot is also stopped over the Drive card's socket first, when one is open. Each robot's latch
 // then shows through its own pages' event streams; this only says whether the request landed.
-import { ApiError, api } from './api.js';
-import { operatorName } from './operator.js';
-import { sendEstopOverSocket } from './teleop_link.js';
+import { ApiError, api } from '../core/api.js';
+import { operatorName } from '../core/operator.js';
+import { sendEstopOverSocket } from '../teleop/teleop_link.js';
 
 const RETRY_MS = 250;
 const ATTEMPTS = 40;

@@ -1,6 +1,6 @@
 // The geofence warning on every page: shown while the robot's GPS fix is outside the fence
 // (the server decides; rover_web/geofence), hidden once it is back inside.
-import { on } from './live.js';
+import { on } from '../live/live.js';
 
 const banner = document.getElementById('geofence-banner');
 const text = document.getElementById('geofence-banner-text');

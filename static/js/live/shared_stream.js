@@ -23,7 +23,7 @@
 //   event {channel, data, id}
 //   snapshot {to, events}   the current value of each conflated channel, for a tab that joined
 
-import { base } from './api.js';
+import { base } from '../core/api.js';
 import { Source, duplicateFilter } from './stream_source.js';
 
 // Per robot: tabs of different robots (/robots/<name>/...) must never share one robot's events.

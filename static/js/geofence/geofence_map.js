@@ -5,8 +5,8 @@
 // whose refusal (400 with the feature named, 403 below admin) is shown as it is. Below admin the
 // page renders the editor's fieldset disabled with the reason (templates/panels/waypoints.html);
 // a role lowered after the page loaded still meets the server's 403, in the server's words.
-import { api } from './api.js';
-import { on } from './live.js';
+import { api } from '../core/api.js';
+import { on } from '../live/live.js';
 
 const EMPTY = { type: 'FeatureCollection', features: [] };
 const KIND_TITLES = { keep_in: 'keep-in', keep_out: 'keep-out' };
