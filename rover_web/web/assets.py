@@ -179,7 +179,7 @@ def init_app(app: Flask) -> None:
                     immutable_file_test=lambda path, url: True)
     # Only the current files: the store may also hold earlier versions, which nobody is sent to.
     static_url = app.static_url_path.rstrip("/")
-    for name, hashed in manifest.hashed.items():
+    for hashed in manifest.hashed.values():
         wn.add_file_to_dictionary(f"{static_url}/{hashed}", str(build_dir / hashed), stat_cache=None)
     app.wsgi_app = wn
 

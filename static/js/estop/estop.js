@@ -93,6 +93,9 @@ async function release() {
 
 if (box) {
   engageButton.addEventListener('click', engage);
+  // The e-stop is a form so that it works before this module runs (partials/estop.html); from now
+  // on the click above engages, over the open socket first, and the form is not sent too.
+  box.addEventListener('submit', (event) => event.preventDefault());
   releaseButton.addEventListener('click', () => openDialog(true));
   // <form method="dialog">: the button pressed is the dialog's returnValue; Escape closes with ''.
   dialog.addEventListener('close', () => { if (dialog.returnValue === 'release') release(); });

@@ -114,7 +114,14 @@ function watchdog() {
 // microtask checkpoint between them: opening in a microtask would open before the page's later
 // modules called on(). DOMContentLoaded fires only after every deferred/module script ran.
 let opened = false;
-const openOnce = () => { if (!opened) { opened = true; lastMessageAt = restartedAt = performance.now(); open(); } };
+const openOnce = () => {
+  if (opened) return;
+  opened = true;
+  // Every module of the page has run: the "scripts have not loaded yet" notice is no longer true.
+  document.getElementById('scripts-pending')?.remove();
+  lastMessageAt = restartedAt = performance.now();
+  open();
+};
 if (document.readyState === 'complete') queueMicrotask(openOnce);
 else {
   document.addEventListener('DOMContentLoaded', openOnce);
