@@ -108,6 +108,5 @@ document.addEventListener('visibilitychange', () => {
 
 // The markers and their framing are static/js/fleet/map.js's, shared with the hub's page.
 const fleetMap = createFleetMap($('fleet-map'), $('fleet-map-note'));
-if (fleetMap) window.roverFleetMap = fleetMap.map;  // for the browser tests and the curious operator's console
 render(latest);
 timer = setTimeout(poll, POLL_MS);

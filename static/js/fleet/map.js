@@ -5,6 +5,7 @@
 // Untrusted text (titles) only ever goes through textContent; a URL is followed only if http(s)
 // (a path on this server is too).
 import { createGpsMap, fmtLatLng } from '../gps/gps_map.js';
+import { loadMaplibre } from '../core/vendor.js';
 
 // 'engaged', 'released', or 'unknown' (a robot the hub has heard no summary from yet).
 export function estopState(robot) {
@@ -59,9 +60,9 @@ function showOnMarker(node, robot) {
   node.setAttribute('aria-label', url ? `${robot.title}: open its dashboard` : robot.title);
 }
 
-// The map in `container` (its data-config: the server's map config), or null when this browser
-// cannot show one: then `note` says so and the page's table goes on alone. render(robots) places
-// every robot; robots given before the map has loaded are placed once it has.
+// The map in `container` (its data-config: the server's map config), drawn once MapLibre has come;
+// when this browser cannot show one, `note` says so and the page's table goes on alone.
+// render(robots) places every robot; robots given before the map has loaded are placed once it has.
 export function createFleetMap(container, note) {
   const markers = new Map();  // robot name -> maplibregl.Marker
   let userMoved = false;  // once the operator pans or zooms, the map stops framing the robots itself
@@ -106,17 +107,26 @@ export function createFleetMap(container, note) {
     frame(robots);
   }
 
-  try {
-    map = createGpsMap(container, JSON.parse(container.dataset.config), {
-      onLoad: () => { ready = true; render(latest); },
-    });
-  } catch (err) {
+  // MapLibre comes after the page is live (core/vendor.js); the table works before it.
+  const fleetMap = { map: null, render };
+  const noMap = (err) => {
     note.hidden = false;
     note.textContent = `The map cannot be shown in this browser (${err.message}); the table still works.`;
-    return null;
-  }
-  for (const start of ['dragstart', 'zoomstart']) {
-    map.on(start, (e) => { if (e.originalEvent) userMoved = true; });
-  }
-  return { map, render };
+  };
+  loadMaplibre().then(() => {
+    try {
+      map = createGpsMap(container, JSON.parse(container.dataset.config), {
+        onLoad: () => { ready = true; render(latest); },
+      });
+    } catch (err) {
+      noMap(err);
+      return;
+    }
+    fleetMap.map = map;
+    window.roverFleetMap = map;  // for the browser tests and the curious operator's console
+    for (const start of ['dragstart', 'zoomstart']) {
+      map.on(start, (e) => { if (e.originalEvent) userMoved = true; });
+    }
+  }, noMap);
+  return fleetMap;
 }

@@ -78,7 +78,6 @@ button.addEventListener('click', async () => {
 
 const fleetMap = createFleetMap(document.getElementById('hub-map'), document.getElementById('hub-map-note'));
 if (fleetMap) {
-  window.roverFleetMap = fleetMap.map;  // for the browser tests and the curious operator's console
   fleetMap.render(JSON.parse(document.getElementById('hub-state').textContent).robots);
 }
 setInterval(refresh, 1000);

@@ -4,6 +4,7 @@
 // 3 ms round trip and a 4 s silence both stay readable).
 import { at } from '../core/api.js';
 import { on } from '../live/live.js';
+import { loadUplot } from '../core/vendor.js';
 
 const KEEP = 300;
 const el = document.getElementById('link-plot');
@@ -45,6 +46,9 @@ function newestAgeMs(status) {
     .map((x) => x.age_s * 1000);
   return ages.length ? Math.max(0.1, Math.min(...ages)) : null;
 }
+
+// uPlot comes after the page is live (core/vendor.js); the points gathered until then are drawn then.
+if (el) loadUplot().then(draw, () => {});
 
 on('status', async (status) => {
   if (!el || pinging || document.hidden) return;

@@ -6,6 +6,7 @@ import { api } from '../core/api.js';
 import { on } from '../live/live.js';
 import { attachGeofence } from '../geofence/geofence_map.js';
 import { createGpsMap, fmtLatLng } from '../gps/gps_map.js';
+import { loadMaplibre } from '../core/vendor.js';
 import { ROBOT_LAYERS, ROBOT_SOURCES, createRobot } from '../gps/robot.js';
 
 const el = document.getElementById('wp-map');
@@ -167,24 +168,28 @@ function init(container) {
     await refresh();
   });
 
-  // --- the map ---
+  // --- the map: MapLibre comes after the page is live (core/vendor.js); the list works before it ---
 
-  try {
-    map = createGpsMap(container, cfg, {
-      sources: ROBOT_SOURCES,
-      layers: ROBOT_LAYERS,
-      onLoad: () => robot.loaded(),
-    });
-    robot.attach(map);
-  } catch (err) {
+  function noMap(err) {
     const note = $('wp-map-note');
     note.hidden = false;
     note.textContent = `The map cannot be shown in this browser (${err.message}); the list still works.`;
     map = null;
   }
-  let geofence = { handleClick: () => false };
-  if (map) {
-    geofence = attachGeofence(map);
+
+  function attachMap() {
+    try {
+      map = createGpsMap(container, cfg, {
+        sources: ROBOT_SOURCES,
+        layers: ROBOT_LAYERS,
+        onLoad: () => robot.loaded(),
+      });
+      robot.attach(map);
+    } catch (err) {
+      noMap(err);
+      return;
+    }
+    const geofence = attachGeofence(map);
     map.on('click', (e) => {
       const target = e.originalEvent && e.originalEvent.target;
       if (target && target.closest && target.closest('.maplibregl-marker, .maplibregl-popup')) return;
@@ -193,7 +198,9 @@ function init(container) {
     });
     map.on('mousemove', (e) => { $('wp-cursor').textContent = fmtLatLng(e.lngLat.lat, e.lngLat.lng); });
     window.roverWaypointsMap = map;  // for the browser tests and the curious operator's console
+    render(state.mission, true);  // the markers of what the list already shows
   }
+  loadMaplibre().then(attachMap, noMap);
 
   render(JSON.parse($('wp-mission').textContent));
   robot.showFix(JSON.parse($('wp-fix-state').textContent));
