@@ -191,6 +191,10 @@ def init_app(app: Flask) -> None:
     # Pages and JSON above a small size are compressed as they go out (Flask-Compress). Streams are
     # not: an event stream is written by the Broadcaster, and a streamed body stays as it is.
     app.config.setdefault("COMPRESS_ALGORITHM", ["br", "gzip"])
+    # What is text; never text/event-stream (the event stream) nor multipart (the camera's MJPEG).
+    app.config.setdefault("COMPRESS_MIMETYPES", ["text/html", "text/css", "text/plain", "text/javascript",
+                                                 "application/javascript", "application/json",
+                                                 "application/geo+json", "application/xml", "image/svg+xml"])
     app.config.setdefault("COMPRESS_MIN_SIZE", 1024)
     app.config.setdefault("COMPRESS_STREAMS", False)
     app.config.setdefault("COMPRESS_BR_LEVEL", 4)

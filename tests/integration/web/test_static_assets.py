@@ -80,3 +80,13 @@ def test_every_module_a_page_imports_statically_is_preloaded(app, client):
     eager, _ = manifest.closure(entries)
     assert set(eager) - set(entries) == preloaded
     assert "js/core/api.js" in preloaded and "js/live/shared_stream.js" in preloaded
+
+
+def test_the_drawn_basemap_and_big_json_are_compressed_and_the_event_stream_is_not(app):
+    client = app.test_client()
+    basemap = client.get("/basemap/benderson_park", headers={"Accept-Encoding": "gzip"})
+    assert basemap.status_code == 200 and basemap.headers["Content-Encoding"] == "gzip"
+    with client.get("/api/events?channels=status", headers={"Accept-Encoding": "br, gzip"},
+                    buffered=False) as events:
+        assert events.mimetype == "text/event-stream"
+        assert "Content-Encoding" not in events.headers
