@@ -28,6 +28,7 @@ import logging
 import os
 import re
 import secrets
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -161,10 +162,13 @@ def _page_head(manifest: Manifest, body: str, static_root: str) -> tuple[str, st
     return "\n".join(lines) + "\n", nonce
 
 
+def build_dir_for(static_dir: Path, setting: str | None) -> Path:
+    return Path(setting) if setting else static_dir.parent / "build" / "static"
+
+
 def init_app(app: Flask) -> None:
-    settings_dir = app.config.get("ROVER_WEB_STATIC_BUILD_DIR")
     static_dir = Path(app.static_folder)
-    build_dir = Path(settings_dir) if settings_dir else static_dir.parent / "build" / "static"
+    build_dir = build_dir_for(static_dir, app.config.get("ROVER_WEB_STATIC_BUILD_DIR"))
     try:
         build_dir.mkdir(parents=True, exist_ok=True)
         manifest = build(static_dir, build_dir)
@@ -217,3 +221,14 @@ def init_app(app: Flask) -> None:
         response.headers["Content-Security-Policy"] = CONTENT_SECURITY_POLICY.replace(
             "script-src 'self'", f"script-src 'self' 'nonce-{nonce}'")
         return response
+
+
+if __name__ == "__main__":
+    # `python -m rover_web.web.assets`: fill the store before the first start (scripts/demo.sh and
+    # scripts/test.sh do), so that start, or two test workers at once, do not compress it themselves.
+    started = time.monotonic()
+    static = Path(__file__).resolve().parents[2] / "static"
+    store = build_dir_for(static, os.environ.get("ROVER_WEB_STATIC_BUILD_DIR"))
+    store.mkdir(parents=True, exist_ok=True)
+    built = build(static, store)
+    print(f"static files: {len(built.hashed)} hashed and compressed in {store} ({time.monotonic() - started:.1f} s)")
