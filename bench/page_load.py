@@ -2,7 +2,7 @@
 
     .venv/bin/python bench/page_load.py --profile radio|wifi-edge|starlink|wifi-good|loopback
                                         [--pages dashboard,waypoints,livemap,robots,plot,recordings]
-                                        [--tree /work/main] [--timeout 60] [--seed 1]
+                                        [--tree /work/main] [--timeout 60] [--seed 1] [--no-preload]
 
 Starts the demo's simulator (`python -m rover_web.sim`) and the app (`flask run`, from --tree: this
 checkout by default; another checkout, such as main, to measure before a change: started with no
@@ -32,6 +32,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -117,6 +118,18 @@ class NetLog:
         return body, len(network), [self.sent[rid] for rid in network]
 
 
+def strip_preload(route) -> None:
+    """--no-preload: the page as it would be without its modulepreload links (the import map stays), to
+    measure what naming every module up front saves. The document is fetched through the link as usual."""
+    if route.request.resource_type != "document":
+        route.fallback()
+        return
+    response = route.fetch()
+    body = re.sub(r'<link rel="modulepreload"[^>]*>\n?', "", response.text())
+    headers = {k: v for k, v in response.headers.items() if k.lower() not in ("content-encoding", "content-length")}
+    route.fulfill(status=response.status, headers=headers, body=body)
+
+
 def start_app(tree: Path, env: dict, scratch: str) -> tuple[subprocess.Popen, str]:
     port = free_port()
     env = {**env, "PYTHONPATH": str(tree), "PYTHONDONTWRITEBYTECODE": "1",
@@ -190,6 +203,8 @@ def run(args) -> dict:
             for name in pages:
                 context = browser.new_context(viewport={"width": 1280, "height": 900}, bypass_csp=True)
                 context.add_init_script(OBSERVE)
+                if args.no_preload:
+                    context.route("**/*", strip_preload)
                 page = context.new_page()
                 cdp = context.new_cdp_session(page)
                 cdp.send("Network.enable")
@@ -225,7 +240,8 @@ def run(args) -> dict:
         stop_process(sim)
         scratch.cleanup()
     return {"bench": "page_load", "profile": link.name, "link": link.describe(), "tree": str(tree), "commit": head,
-            "seed": args.seed, "machine": machine(), "load": round(os.getloadavg()[0], 1), "pages": results}
+            "seed": args.seed, "preload": not args.no_preload, "machine": machine(),
+            "load": round(os.getloadavg()[0], 1), "pages": results}
 
 
 def git_head(tree: Path) -> str:
@@ -244,6 +260,8 @@ def main() -> None:
     parser.add_argument("--tree", default=str(ROOT), help="the checkout whose app is measured (default: this one)")
     parser.add_argument("--timeout", type=float, default=60.0, help="per load, seconds")
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--no-preload", action="store_true",
+                        help="strip the pages' modulepreload links (what naming the modules up front saves)")
     print(json.dumps(run(parser.parse_args())), flush=True)
 
 

@@ -27,7 +27,7 @@ def run_bench(*args: str, timeout: float) -> dict:
 def test_the_page_load_bench_prints_its_figures_as_json():
     result = run_bench("bench/page_load.py", "--profile", "loopback", "--pages", "waypoints", "--timeout", "40",
                        timeout=240)
-    assert result["bench"] == "page_load" and result["profile"] == "custom"
+    assert result["bench"] == "page_load" and result["profile"] == "custom" and result["preload"] is True
     page = result["pages"]["waypoints"]
     assert "error" not in page, page
     for kind in ("cold", "warm"):
