@@ -150,7 +150,7 @@ def hang_up(ws) -> None:
 
 def frame(linear: float, angular: float = 0.0, epoch: int = 0,
           seq: int | None = None, t_ms: float | None = None) -> str:
-    """A drive frame. With `seq` and `t_ms` it is the Drive card's (static/js/teleop.js): the server
+    """A drive frame. With `seq` and `t_ms` it is the Drive card's (static/js/teleop/teleop.js): the server
     dates its freshness, jitter and stalls from `t_ms` and drops it if `seq` is not newer, so a
     bench that leaves them out measures the rule for clients without them, not the page's. This
     loopback bench leaves them out: it builds its frames seconds before sending them."""

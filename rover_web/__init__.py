@@ -59,6 +59,9 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         return app
     if process.is_cli_command_lookup():
         return app  # a CLI command, not a server: no node, no database, no stop-on-exit hooks
+    from rover_web.web import assets
+
+    assets.init_app(app)  # hashed, pre-compressed static files and each page's modules named up front
     if settings["ROVER_WEB_HUB"]:
         from rover_web import hub  # a fleet hub: robots heard over Zenoh, and no ROS at all
 

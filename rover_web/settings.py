@@ -34,6 +34,9 @@ SETTINGS: tuple[Setting, ...] = (
             "listens, or sign-in stays required (ROVER_WEB_AUTH=auto); 0.0.0.0 exposes the GUI"),
     Setting("PORT", 5000, "int", "port `python -m rover_web.demo` and gunicorn.conf.py listen on", 1, 65535),
     Setting("SHUTDOWN_TIMEOUT_S", 2.0, "float", "how long shutdown waits for the executor thread", 0.1, 30),
+    Setting("STATIC_BUILD_DIR", None, "optional_str",
+            "where hashed, brotli and gzip copies of static/ are kept (made at start, content-addressed); "
+            "unset: build/static beside static/ (docs/page_load.md)"),
     Setting("DB_PATH", None, "optional_str",
             "SQLite database file; unset means rover_web.sqlite3 in the Flask instance folder"),
     # --- HTTP protection ---

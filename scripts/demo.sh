@@ -4,4 +4,5 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/bootstrap.sh --gui
+.venv/bin/python -m rover_web.web.assets  # hashed, compressed static files (once per content; docs/page_load.md)
 exec .venv/bin/python -m rover_web.demo "$@"

@@ -10,4 +10,5 @@ echo "== ruff check"
 # Two workers (pytest-xdist), one per core of CI's: the suite is mostly waiting on servers, ROS peers
 # and Chromium, but three made its timing tests flaky (docs/testing.md). ROVER_WEB_TEST_WORKERS=0
 # runs it in one process.
+.venv/bin/python -m rover_web.web.assets  # the static store once, not by each worker's first app
 exec .venv/bin/python -m pytest -n "${ROVER_WEB_TEST_WORKERS:-2}" "$@"

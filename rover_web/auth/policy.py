@@ -35,6 +35,7 @@ PUBLIC_ENDPOINTS = frozenset({"auth.login_form", "auth.login", "estop.login_esto
 # layouts.choose_layout: which layout the caller's own dashboard shows (a viewer picks; only operators
 # and admins change layouts).
 ANY_USER_ENDPOINTS = frozenset({"auth.logout", "auth.revoke_my_sessions", "estop.estop_set", "estop.estop_all",
+                                "estop.estop_form",
                                 "hub.estop_all", "layouts.choose_layout",
                                 "camera_webrtc.whep_offer", "camera_webrtc.whep_end", "camera.viewer_ack"})
 ADMIN_ENDPOINT_PREFIX = "auth.admin_"

@@ -3,7 +3,7 @@
 A folder (ROVER_WEB_MAP_GEOJSON_DIR, default map_files/basemap/) of `<name>.geojson` files, each a
 FeatureCollection whose features say what they are in `properties.kind` (KINDS) and whose top
 level may carry `name`, `attribution` and `license` (GeoJSON allows such foreign members). The map
-draws them under its grid with the style in static/js/gps_map.js; the credit line shows the
+draws them under its grid with the style in static/js/gps/gps_map.js; the credit line shows the
 attribution. Files are checked when read: a broken one is left out with a warning, never served.
 """
 

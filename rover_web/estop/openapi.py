@@ -32,6 +32,18 @@ PATHS = {
                         "(`POST /robots/<name>/api/estop`): `{\"engaged\": false}` here is a 400.",
             fuzz="last", fuzz_why="engaged, it turns every motion route into a 409 for the rest of the run"),
     },
+    "/estop": {
+        "post": op(
+            "The header's E-STOP as a plain HTML form: engages, before or without the page's scripts",
+            tag="estop", ok={"type": "string"}, media="text/html",
+            form=obj({"back": {"type": "string", "maxLength": 2000,
+                               "description": "the page the form was on (a path of this app), linked back to"}},
+                     closed=False),
+            body=obj(closed=False), body_required=False,
+            description="Engages only, as `POST /api/estop {\"engaged\": true}` (same Origin check, any "
+                        "signed-in user); the answer is a page saying the e-stop is engaged.",
+            fuzz="last", fuzz_why="engaged, it turns every motion route into a 409 for the rest of the run"),
+    },
     "/login/estop": {
         "post": op(
             "The sign-in page's e-stop: engage every robot, without signing in", tag="estop", public=True,

@@ -96,6 +96,23 @@ def login_estop():
     return _login_page(200, "E-stop engaged on every robot. Releasing it needs an operator to sign in.")
 
 
+@bp.post("/estop")
+@accepts_form
+def estop_form():
+    """The header's E-STOP as a plain form (templates/partials/estop.html): it engages before the
+    page's scripts have run, on a slow link, or with scripts off. Engage only, under the rules of
+    POST /api/estop {"engaged": true}: the guard's Origin check, any signed-in user. The answer is a
+    page that says the robot is stopped, with the way back to the page the form was on."""
+    estop = current_feature(EStopService)
+    back = request.form.get("back", "") if request.mimetype != "application/json" else ""
+    # Only a path of this app: never an address elsewhere (//host or a scheme).
+    if not back.startswith("/") or back.startswith("//") or "\\" in back or len(back) > 2000:
+        back = "/"
+    state = estop.engage(client_name(None), via="form")
+    html = render_template("estop_engaged.html", engaged_state=state, back=request.script_root + back)
+    return make_response(html, 200, {"Content-Type": "text/html; charset=utf-8"})
+
+
 def _login_page(status: int, notice: str, retry_after_s: float | None = None):
     html = render_template("login.html", next=request.script_root + "/", error=None, username="", login_estop=True,
                            estop_notice=notice)

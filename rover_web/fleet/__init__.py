@@ -10,7 +10,7 @@ build_fleet makes one Rover per robot (core/fleet.py); each feature's init_app s
 Pages: with several robots every page's top bar has a robot selector (the same page for another
 robot, templates/partials/robot_select.html) and "Stop all" (partials/estop_all.html), from the
 `fleet_robots`, `current_robot` and `app_root` this package gives every template; the fleet page
-polls /api/robots (static/js/fleet.js says why not a stream per robot).
+polls /api/robots (static/js/fleet/fleet.js says why not a stream per robot).
 Modules: prefix (the WSGI mount), summary (a robot's line on
 the fleet page), routes; the setting and naming rules are rover_web/core/robots.py.
 """

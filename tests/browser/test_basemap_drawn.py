@@ -67,3 +67,14 @@ def test_an_imported_geojson_is_drawn(live_server_factory, page, tmp_path):
     assert close(colour_at(page, -82.455, 27.374), BACKGROUND)            # nothing drawn outside it
     assert "© the pond survey" in page.locator(".maplibregl-ctrl-attrib-inner").text_content()
     assert page.watch.offhost == [] and page.watch.console_errors == []
+
+
+def test_the_fleet_page_draws_the_same_demo_basemap_and_does_not_say_none_is_installed(live_server, page):
+    # The fleet page's note looked at raster tiles only, so with the demo's drawn basemap (and no
+    # tiles) it said "No basemap installed" over a map that drew it.
+    page.goto(live_server.url + "/robots")
+    page.wait_for_selector("#fleet-map[data-ready='yes']", timeout=20000)
+    assert page.locator("#fleet-map-note").is_hidden()
+    page.wait_for_function("() => document.querySelector('#fleet-map .maplibregl-ctrl-attrib-inner')"
+                           " && document.querySelector('#fleet-map .maplibregl-ctrl-attrib-inner').textContent"
+                           ".includes('schematic')", timeout=15000)

@@ -4,7 +4,7 @@ The pad is an init script standing in for `navigator.getGamepads()`: the test se
 buttons and fires `gamepadconnected` / `gamepaddisconnected` as a browser does. The server's
 deadman is 5 s here (as in test_teleop.py), so a zero that arrives within a second of letting go
 of enable, unplugging the pad or hiding the tab was sent by the page, not by the server timing out.
-The pure mapping (static/js/gamepad.js) is tested on its own at the end.
+The pure mapping (static/js/teleop/gamepad.js) is tested on its own at the end.
 """
 
 import time
@@ -339,13 +339,13 @@ def test_a_viewer_gets_no_gamepad_driving(signed_server, page):
 
 @pytest.fixture
 def blank(live_server, page):
-    page.goto(live_server.url + "/static/js/gamepad.js")  # same origin, and no page script of its own
+    page.goto(live_server.url + "/static/js/teleop/gamepad.js")  # same origin, and no page script of its own
     return page
 
 
 def test_mapping_dead_zone_inversion_and_config(blank):
     got = blank.evaluate("""async () => {
-        const g = await import('/static/js/gamepad.js');
+        const g = await import('/static/js/teleop/gamepad.js');
         const cfg = g.normalizeConfig({});
         const pad = (axes, pressed = [], extra = {}) => ({ axes, buttons: Array.from({ length: 17 },
             (_, i) => ({ pressed: pressed.includes(i), value: pressed.includes(i) ? 1 : 0 })), ...extra });
@@ -395,7 +395,7 @@ def test_mapping_dead_zone_inversion_and_config(blank):
 
 def test_enable_gate_and_pacing(blank):
     got = blank.evaluate("""async () => {
-        const g = await import('/static/js/gamepad.js');
+        const g = await import('/static/js/teleop/gamepad.js');
         const r = (enable, linear = 0.5, angular = 0) => ({ enable, linear, angular });
         const gate = new g.EnableGate();
         const seq = [gate.command(r(false)), gate.command(r(true)), gate.command(null)];

@@ -14,7 +14,7 @@ pytestmark = pytest.mark.browser
 GOAL_URL = f"/api/maps/{quote('Science Hall Basement')}/goal"
 
 CALL = """async ([method, url, body]) => {
-    const { api, ApiError } = await import('/static/js/api.js');
+    const { api, ApiError } = await import('/static/js/core/api.js');
     try {
         return { ok: true, reply: await api(method, url, body) };
     } catch (err) {
@@ -26,7 +26,7 @@ CALL = """async ([method, url, body]) => {
 
 @pytest.fixture
 def blank(live_server, page):
-    page.goto(live_server.url + "/static/js/api.js")  # same origin, and no page script of its own
+    page.goto(live_server.url + "/static/js/core/api.js")  # same origin, and no page script of its own
     return page
 
 

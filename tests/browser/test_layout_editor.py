@@ -228,7 +228,7 @@ MODEL = """async ([doc, types]) => {
 
 def test_the_editors_model_places_refuses_undoes_and_saves_what_the_server_accepts(live_server, page):
     types = catalogue()  # what the page embeds for the editor
-    page.goto(live_server.url + "/static/js/api.js")  # same origin, no page script
+    page.goto(live_server.url + "/static/js/core/api.js")  # same origin, no page script
     empty = {"version": 1, "name": "Model", "cards": []}
     steps = page.evaluate(MODEL, [empty, types])
     assert steps["added"] == [["camera", 0, 0, 6, 6], ["scan_the_code", 6, 0, 4, 6], ["gps_map", 0, 6, 8, 7]]

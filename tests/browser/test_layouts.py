@@ -121,7 +121,7 @@ def test_the_page_opens_one_stream_for_its_cards_channels_and_no_video_without_a
         channels = set(streams[0].split("channels=")[1].split("&")[0].split(","))
         assert channels == {"status", "teleop", "odom", "battery"} | ALWAYS
         assert not [u for u in page.requested if u.startswith(VIDEO_PATHS)]
-        assert not [u for u in page.requested if "/js/camera.js" in u or "maplibre" in u or "uPlot" in u]
+        assert not [u for u in page.requested if "/js/camera/camera." in u or "maplibre" in u or "uPlot" in u]
         check_clean(page)
     finally:
         context.close()
@@ -129,7 +129,7 @@ def test_the_page_opens_one_stream_for_its_cards_channels_and_no_video_without_a
     choose(live_server, "Boat")  # a camera card: its script runs and asks for the topic it shows
     context, page = open_dashboard(browser, live_server, DESKTOP)
     try:
-        assert any("/js/camera.js" in u for u in page.requested)
+        assert any("/js/camera/camera." in u for u in page.requested)
         streams = [u for u in page.requested if u.startswith("/api/events")]
         channels = set(streams[0].split("channels=")[1].split("&")[0].split(","))
         assert "light_sequence" in channels and "diagnostics" not in channels and "pose" not in channels

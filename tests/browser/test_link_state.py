@@ -19,7 +19,7 @@ ODOM = "nav_msgs/msg/Odometry"
 # Every odom and status event the page's handlers get, with its id (live.js is a module: importing
 # it again returns the page's own instance).
 RECORD = """async () => {
-  const src = document.querySelector('script[src*="/js/live.js"]').src;
+  const src = document.querySelector('script[src*="/js/live/live."]').src;
   const live = await import(src);
   window.seen = [];
   for (const ch of ['odom', 'status']) {

@@ -36,7 +36,7 @@ HANG = "(ms) => { setTimeout(() => { const end = Date.now() + ms; while (Date.no
 
 # live.js is one module instance per page, so a handler added here sees what the page's own see.
 COLLECT = """async (channel) => {
-    const { on } = await import('/static/js/live.js');
+    const { on } = await import('/static/js/live/live.js');
     window.collected = window.collected || {};
     window.collected[channel] = [];
     on(channel, (data, ev) => window.collected[channel].push(ev.lastEventId));

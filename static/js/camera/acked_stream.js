@@ -7,7 +7,7 @@
 // /api/camera/viewers/<X-Camera-Viewer>/ack; the server writes no more than about a frame beyond
 // what the page has acknowledged (docs/camera.md#acknowledging-pages).
 
-import { api, at, errorFrom } from '../api.js';
+import { api, at, errorFrom } from '../core/api.js';
 
 const HEAD_END = [13, 10, 13, 10];  // \r\n\r\n
 const RETRY_ACK_MS = 500;  // an ack refused or not answered: send the newest count again after this

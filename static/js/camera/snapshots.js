@@ -2,7 +2,7 @@
 // GET /snapshot, asking for the next only when the last one has arrived and a pause has passed
 // (never two in flight, so the link is never filled). The page measures what it gets itself.
 
-import { at, errorFrom } from '../api.js';
+import { at, errorFrom } from '../core/api.js';
 
 export const PERIOD_MS = 2000;
 

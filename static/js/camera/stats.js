@@ -2,7 +2,7 @@
 // this page's viewer (GET /api/camera/viewers?viewer=<label>: the server adapts each MJPEG viewer to
 // its link, docs/camera.md). A few hundred bytes every two seconds, and only while streaming.
 
-import { api } from '../api.js';
+import { api } from '../core/api.js';
 
 const EVERY_MS = 2000;
 

@@ -7,7 +7,7 @@
 // view of how old a shown frame is). The session also carries the `teleop` data channel when
 // this page may drive (camera/teleop_channel.js).
 
-import { at } from '../api.js';
+import { at } from '../core/api.js';
 import { attachTeleopChannel } from './teleop_channel.js';
 
 const STORAGE_KEY = 'rover_web.camera.transport';

@@ -2,7 +2,7 @@
 // the topic browser's echo (GET /api/topics/echo, an event stream of its own, as the Topics page
 // opens one). Like the camera's video it is closed while the tab is hidden, so the server can end
 // the subscription; a layout without an echo card opens none.
-import { at } from '../api.js';
+import { at } from '../core/api.js';
 
 const cards = [...document.querySelectorAll('[data-echo-card]')].map((el) => ({ el, source: null }));
 const part = (card, cls) => card.el.querySelector(`.${cls}`);

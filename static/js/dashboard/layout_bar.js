@@ -1,7 +1,7 @@
 // The dashboard's layout bar: choosing another layout (PUT /api/me/layout, remembered on the robot
 // for this user, or for every browser while sign-in is off) reloads the page, which the server
 // renders from the new layout with only its cards' channels.
-import { api, ApiError } from '../api.js';
+import { api, ApiError } from '../core/api.js';
 
 const select = document.getElementById('layout-select');
 const message = document.getElementById('layout-message');

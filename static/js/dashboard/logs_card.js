@@ -1,8 +1,8 @@
 // Logs cards (templates/cards/logs.html): each keeps its newest lines at or above its level from
 // the `rosout` channel, numbered as the Logs page's are, and re-reads GET /api/rosout when a batch
 // was missed. Every logs card of the page is served by this one module.
-import { api } from '../api.js';
-import { on } from '../live.js';
+import { api } from '../core/api.js';
+import { on } from '../live/live.js';
 
 const LEVELS = { DEBUG: 10, INFO: 20, WARN: 30, ERROR: 40, FATAL: 50 };
 const cards = [...document.querySelectorAll('[data-logs-card]')].map((el) => ({

@@ -2,8 +2,9 @@
 // history from GET /api/plot and growing from the `plot` channel, as on the Plot page (plot.js,
 // which adds series interactively; a card's are fixed by its settings). The server ends a series
 // nobody asked for in a while, so an open card asks again now and then.
-import { api, ApiError } from '../api.js';
-import { on } from '../live.js';
+import { api, ApiError } from '../core/api.js';
+import { on } from '../live/live.js';
+import { loadUplot } from '../core/vendor.js';
 
 const COLOURS = ['#58a6ff', '#e3b341', '#7ee787', '#ff7b72'];
 const KEEP_ALIVE_MS = 10000;
@@ -85,6 +86,8 @@ if (cards.length) {
     }
   });
   cards.forEach(start);
+  // uPlot comes after the page is live (core/vendor.js); what came before is drawn then.
+  loadUplot().then(() => cards.forEach(draw), (err) => cards.forEach((card) => showError(card, err)));
   setInterval(() => {
     for (const card of cards) for (const s of card.series) api('GET', `/api/plot?${query(s, 1)}`).catch(() => {});
   }, KEEP_ALIVE_MS);

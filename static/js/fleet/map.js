@@ -7,7 +7,8 @@
 // a marker whose dot would cover another's moves to the nearest free place on rings around its
 // point (each still opens its own robot), and past CROWDED markers the names show only on hover or focus.
 // A robot the hub forgot leaves the map with the list.
-import { createGpsMap, fmtLatLng } from '../gps_map.js';
+import { createGpsMap, fmtLatLng } from '../gps/gps_map.js';
+import { loadMaplibre } from '../core/vendor.js';
 
 // 'engaged', 'released', or 'unknown' (a robot the hub has heard no summary from yet).
 export function estopState(robot) {
@@ -62,9 +63,9 @@ function showOnMarker(node, robot) {
   node.setAttribute('aria-label', url ? `${robot.title}: open its dashboard` : robot.title);
 }
 
-// The map in `container` (its data-config: the server's map config), or null when this browser
-// cannot show one: then `note` says so and the page's table goes on alone. render(robots) places
-// every robot; robots given before the map has loaded are placed once it has.
+// The map in `container` (its data-config: the server's map config), drawn once MapLibre has come;
+// when this browser cannot show one, `note` says so and the page's table goes on alone.
+// render(robots) places every robot; robots given before the map has loaded are placed once it has.
 const CROWDED = 20;  // markers beyond which names are shown on hover and focus only
 const APART_PX = 20;  // dots (14 px when crowded, 18 px else) kept at least this far apart
 
@@ -143,18 +144,27 @@ export function createFleetMap(container, note) {
     spread();
   }
 
-  try {
-    map = createGpsMap(container, JSON.parse(container.dataset.config), {
-      onLoad: () => { ready = true; render(latest); },
-    });
-  } catch (err) {
+  // MapLibre comes after the page is live (core/vendor.js); the table works before it.
+  const fleetMap = { map: null, render };
+  const noMap = (err) => {
     note.hidden = false;
     note.textContent = `The map cannot be shown in this browser (${err.message}); the table still works.`;
-    return null;
-  }
-  for (const start of ['dragstart', 'zoomstart']) {
-    map.on(start, (e) => { if (e.originalEvent) userMoved = true; });
-  }
-  map.on('zoomend', () => { if (ready) spread(); });
-  return { map, render };
+  };
+  loadMaplibre().then(() => {
+    try {
+      map = createGpsMap(container, JSON.parse(container.dataset.config), {
+        onLoad: () => { ready = true; render(latest); },
+      });
+    } catch (err) {
+      noMap(err);
+      return;
+    }
+    fleetMap.map = map;
+    window.roverFleetMap = map;  // for the browser tests and the curious operator's console
+    for (const start of ['dragstart', 'zoomstart']) {
+      map.on(start, (e) => { if (e.originalEvent) userMoved = true; });
+    }
+    map.on('zoomend', () => { if (ready) spread(); });
+  }, noMap);
+  return fleetMap;
 }

@@ -1,7 +1,7 @@
 // The robot on the GPS map: its fix as a dot coloured by fix quality (NavSatStatus), its heading
 // as an arrow on the dot, its horizontal accuracy as a circle (one standard deviation, from
 // NavSatFix.position_covariance), and its recent track. Channels: `fix` and `heading`.
-import { fmtLatLng } from '../gps_map.js';
+import { fmtLatLng } from './gps_map.js';
 
 const EMPTY = { type: 'FeatureCollection', features: [] };
 const EARTH_RADIUS_M = 6371008.8;

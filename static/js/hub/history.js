@@ -1,6 +1,6 @@
 // A robot's history on the hub (GET /api/robots/<name>/history), newest first, a page at a time:
 // found, waiting, live, lost, forgotten, e-stop engaged or released (by whom), stop-all answers.
-import { api } from '../api.js';
+import { api } from '../core/api.js';
 
 function describe(e) {
   const d = e.detail || {};

@@ -2,7 +2,7 @@
 // "Stop all" posts POST /api/estop/all, then shows each robot's answer (engaged, refused, no_answer).
 // The table (table.js) sorts and filters; a row's "history" opens the robot's history (history.js);
 // the map is the fleet page's (static/js/fleet/map.js): each robot with a position, dimmed once lost.
-import { api } from '../api.js';
+import { api } from '../core/api.js';
 import { createFleetMap } from '../fleet/map.js';
 import { createHistory } from './history.js';
 import { createTable } from './table.js';
@@ -71,7 +71,6 @@ const initial = JSON.parse(document.getElementById('hub-state').textContent).rob
 table.render(initial);
 const fleetMap = createFleetMap(document.getElementById('hub-map'), document.getElementById('hub-map-note'));
 if (fleetMap) {
-  window.roverFleetMap = fleetMap.map;  // for the browser tests and the curious operator's console
   fleetMap.render(initial);
 }
 setInterval(refresh, 1000);

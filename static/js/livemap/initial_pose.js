@@ -2,7 +2,7 @@
 // and drag towards where it faces; AMCL re-seeds from POST /api/maps/<map>/initial_pose, which the
 // server publishes on /initialpose. A click without a drag keeps the heading the robot believes it
 // has (or east, with no pose), since an operator correcting a position rarely knows a better one.
-import { api, ApiError } from '../api.js';
+import { api, ApiError } from '../core/api.js';
 import { isDrag, mapYawOfScreen, screenAngle, screenToWorld, wrapAngle } from './geometry.js';
 import { degrees, fmt, say } from './readout.js';
 

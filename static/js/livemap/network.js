@@ -1,7 +1,7 @@
 // Everything this page says to and hears from the server: goal requests, and the pose, goal, plan
 // and live_map channels of the page's one event stream (live.js).
-import { api, ApiError } from '../api.js';
-import { on, onServerState } from '../live.js';
+import { api, ApiError } from '../core/api.js';
+import { on, onServerState } from '../live/live.js';
 import { geometryOfLiveMap } from './geometry.js';
 import { degrees, fmt, say } from './readout.js';
 

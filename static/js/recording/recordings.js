@@ -2,7 +2,7 @@
 // everyone sees the running recording's status (and, once it ends, why) and the list with download
 // links. The list is read from GET /api/recordings every second while the page is open: one small
 // JSON a second, and no event channel to keep for a page few people have open.
-import { api, at, errorFrom } from '../api.js';
+import { api, at, errorFrom } from '../core/api.js';
 
 const $ = (id) => document.getElementById(id);
 const form = $('rec-form');

@@ -3,7 +3,7 @@
 // LiveMap, the plots' topics and the lists; the diagnostics board and the camera frame at the
 // slider's time are asked for as it moves (replay/*.js). Every request is a GET of the recording:
 // this page sends nothing to the robot and publishes nothing.
-import { api } from '../api.js';
+import { api } from '../core/api.js';
 import { lastIndexAtOrBefore } from './replay/at.js';
 import { createCamera } from './replay/camera.js';
 import { createDiagnostics } from './replay/diagnostics.js';

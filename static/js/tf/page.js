@@ -1,8 +1,8 @@
 // The TF page (and the replay view's frames card): the tree from the page's first snapshot, then
 // from each `tf` event (one a second) on the live page; a click shows a frame's details; the
 // lookup form asks the server (tf2's answer or its reason).
-import { on } from '../live.js';
-import { api } from '../api.js';
+import { on } from '../live/live.js';
+import { api } from '../core/api.js';
 import { showTree } from './tree.js';
 
 const $ = (id) => document.getElementById(id);

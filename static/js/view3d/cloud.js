@@ -2,7 +2,7 @@
 // asked for again as soon as one arrives (a long poll keyed by sequence, so a viewer never gets the same
 // cloud twice and a slow one skips to the newest). Only while the view is shown: stop() ends the loop.
 import * as THREE from './three.js';
-import { at } from '../api.js';
+import { at } from '../core/api.js';
 import { matrixOf } from './poses.js';
 
 export function decodeCloud(buffer) {

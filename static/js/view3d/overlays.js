@@ -2,8 +2,8 @@
 // server): the laser scan, costmaps and the live occupancy grid as textured ground planes, and the Nav2
 // plan, all in the map frame; the GPS track in local east-north-up metres around its first fix.
 import * as THREE from './three.js';
-import { at } from '../api.js';
-import { on } from '../live.js';
+import { at } from '../core/api.js';
+import { on } from '../live/live.js';
 import { renderCostmap } from '../livemap/layers/costmap.js';
 import { disposeTree } from './labels.js';
 

@@ -3,7 +3,7 @@
 // then placed from TF on its own, as RViz's RobotModel does: the links are lifted out of urdf-loader's
 // joint tree, and a link TF does not know keeps its pose from the URDF (zero joints) under the root.
 import * as THREE from './three.js';
-import { at } from '../api.js';
+import { at } from '../core/api.js';
 
 const MESH_LOADERS = {
   stl: (url, manager, material, done) => new THREE.STLLoader(manager).load(url,

@@ -3,8 +3,8 @@
 // It draws only while shown: a hidden tab or a card scrolled out of sight stops the drawing loop and
 // the cloud's long poll (the `view3d` channel is small and shared with the page's other channels).
 import * as THREE from './three.js';
-import { api, at } from '../api.js';
-import { on } from '../live.js';
+import { api, at } from '../core/api.js';
+import { on } from '../live/live.js';
 import { CloudLayer } from './cloud.js';
 import { MarkerLayer } from './markers.js';
 import { Overlays } from './overlays.js';

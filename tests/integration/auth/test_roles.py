@@ -18,6 +18,7 @@ LAYOUT = {"version": 1, "name": "roles", "cards": [{"type": "drive", "x": 0, "y"
 REQUESTS = [
     ("POST", "/api/estop", {"engaged": True}, "viewer", "/api/estop"),
     ("POST", "/api/estop/all", {}, "viewer", "/api/estop/all"),
+    ("POST", "/estop", {}, "viewer", "/estop"),  # the header's form (scripts off); engages only
     ("POST", "/api/estop", {"engaged": False}, "operator", "/api/estop"),
     ("POST", "/api/teleop", {"command": "stop"}, "operator", "/api/teleop"),
     ("POST", "/api/maps/{map}/goal", {"x": 0.0, "y": 0.0}, "operator", "/api/maps/<name>/goal"),

@@ -126,7 +126,7 @@ def test_admin_manages_users_over_the_api(signed_app):
 
 def test_security_headers_on_every_response(signed_app):
     client = signed_app.test_client()
-    for path in ("/login", "/api/status", "/static/js/api.js"):
+    for path in ("/login", "/api/status", "/static/js/core/api.js"):
         with client.get(path) as response:
             assert "default-src 'self'" in response.headers["Content-Security-Policy"]
             assert "frame-ancestors 'none'" in response.headers["Content-Security-Policy"]

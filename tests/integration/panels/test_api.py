@@ -240,7 +240,7 @@ def test_pages_render_the_panel_with_its_state(client):
     assert 'href="/panels"' in client.get("/").get_data(as_text=True)
     assert client.get("/panels").status_code == 200
     dashboard = client.get("/").get_data(as_text=True)
-    assert 'data-panel-summary="drone"' in dashboard and "/static/js/panels.js" in dashboard
+    assert 'data-panel-summary="drone"' in dashboard and "/static/js/panels/panels." in dashboard
     assert re.search(r'data-channels="[^"]*\bpanel\b', dashboard)
 
 

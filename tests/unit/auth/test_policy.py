@@ -8,7 +8,7 @@ from rover_web.auth.policy import is_loopback, required_role, role_allows, sign_
 @pytest.mark.parametrize("method,path,endpoint,role", [
     ("GET", "/login", "auth.login_form", None),
     ("POST", "/login", "auth.login", None),
-    ("GET", "/static/js/api.js", "static", None),
+    ("GET", "/static/js/core/api.js", "static", None),
     ("GET", "/", "pages.dashboard", "viewer"),
     ("GET", "/api/events", "sse.events", "viewer"),
     ("GET", "/stream", "camera.stream", "viewer"),

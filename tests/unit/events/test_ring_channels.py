@@ -1,4 +1,4 @@
-"""The pages' shared event stream (static/js/shared_stream.js) hands a tab that joins the newest
+"""The pages' shared event stream (static/js/live/shared_stream.js) hands a tab that joins the newest
 value of each channel, except on the channels the server emits into its ring: those events count
 one by one, and an old one must not look new. The browser cannot tell the two kinds apart, so the
 list is written out there; this test keeps it equal to the channels the server's code emits on."""

@@ -4,7 +4,7 @@
 // goes through the model (model.js), so Undo takes back the last one whatever made it. Save sends
 // the layout to the REST API; the server checks it (a 400 names the field) and the page reloads to
 // render it, with only the channels its cards need.
-import { api, ApiError } from '../../api.js';
+import { api, ApiError } from '../../core/api.js';
 import { LayoutModel } from './model.js';
 import { fill, read } from './settings_form.js';
 

@@ -2,8 +2,8 @@
 // path, the footprint, markers and the laser scan. Each layer is switched on and off by its
 // checkbox (remembered in this browser), and keeps only its newest value from the event stream;
 // drawing happens in the page's one animation frame (livemap.js), never on arrival.
-import { api } from '../../api.js';
-import { on } from '../../live.js';
+import { api } from '../../core/api.js';
+import { on } from '../../live/live.js';
 import { drawCostmap, renderCostmap } from './costmap.js';
 import { drawFootprint, drawMarker, drawPath, drawScan } from './shapes.js';
 

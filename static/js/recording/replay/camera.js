@@ -1,6 +1,6 @@
 // The replay's camera: the recorded frame at the slider's time, decoded and encoded as JPEG on the
 // server (GET .../frame?topic=&t=; 204 before the topic's first frame), shown as an image.
-import { at, errorFrom } from '../../api.js';
+import { at, errorFrom } from '../../core/api.js';
 import { newestOnly } from './at.js';
 
 const IMAGE_TYPES = new Set(['sensor_msgs/msg/Image', 'sensor_msgs/msg/CompressedImage']);

@@ -1,7 +1,7 @@
 // The replay's diagnostics: the board as the live page showed it at the slider's time (GET
 // .../diagnostics?t=, worked out on the server by the live board's own code), drawn by the
 // diagnostics page's table (diagnostics/board.js).
-import { api } from '../../api.js';
+import { api } from '../../core/api.js';
 import { showBoard } from '../../diagnostics/board.js';
 import { newestOnly } from './at.js';
 

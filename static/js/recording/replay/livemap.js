@@ -2,7 +2,7 @@
 // drawn by the LiveMap page's own modules (livemap/geometry.js, view.js, draw.js, and input.js for
 // pan and zoom), so a replayed pose lands on the same pixel a live one did. Nothing here sends a
 // goal: the input's goal callbacks are given nothing to do, and livemap/network.js is not imported.
-import { api } from '../../api.js';
+import { api } from '../../core/api.js';
 import { geometryOf } from '../../livemap/geometry.js';
 import { createViewport } from '../../livemap/view.js';
 import { drawScene, scaleBar } from '../../livemap/draw.js';

@@ -2,7 +2,7 @@
 // the plot page's chart (plot/chart.js) with a line at the slider's time, and each field's value
 // at that time beside it. Fields and series come from the recording (GET .../fields, .../series),
 // read and thinned on the server.
-import { api, ApiError } from '../../api.js';
+import { api, ApiError } from '../../core/api.js';
 import { chartWidth, joined, makeChart, seriesItems } from '../../plot/chart.js';
 import { lastIndexAtOrBefore } from './at.js';
 

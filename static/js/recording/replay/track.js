@@ -1,7 +1,7 @@
 // The replay's track: the recording's GPS track on the waypoints map (MapLibre, with the offline
 // basemap when one is installed) or, without GPS, its odometry track on a plain canvas; the past
 // part drawn darker and the robot's place at the slider's time as a dot.
-import { createGpsMap } from '../../gps_map.js';
+import { createGpsMap } from '../../gps/gps_map.js';
 import { lastIndexAtOrBefore } from './at.js';
 
 function chooseTrack(series) {
