@@ -282,10 +282,9 @@ class WebRtcService:
             raise InvalidInput("the body is not an SDP offer (it must start with v=0)", "bad_sdp")
         if "\nm=video " not in offer.replace("\r\n", "\n"):
             raise NoVideo("the offer has no video media section: add a recvonly video transceiver", "no_video")
-        offer, kept, dropped = screen_remote_candidates(offer)
-        if dropped and not kept:
-            raise InvalidInput("none of the offer's ICE candidates can be checked (multicast, broadcast, unspecified "
-                               "or named addresses, or ports below 1024)", "no_usable_candidates")
+        # An offer left with no candidate is still answered: the browser's own checks reach ours and
+        # are answered as peer-reflexive, so nothing is sent to a place the offer named.
+        offer, _kept, _dropped = screen_remote_candidates(offer)
         session = self._reserve(key, user, role, may_operate, slot)
         try:
             client = session.client
