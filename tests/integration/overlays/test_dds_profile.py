@@ -95,7 +95,8 @@ class App:
         except subprocess.TimeoutExpired:
             self.proc.kill()
             self.proc.wait(5)
-        return self.proc.stderr.read().decode(errors="replace")
+        with self.proc.stderr:
+            return self.proc.stderr.read().decode(errors="replace")
 
 
 @pytest.fixture
@@ -106,11 +107,11 @@ def flood():
 
 
 def test_a_hostile_marker_array_is_given_back_and_markers_and_large_images_still_arrive(tmp_path, flood):
+    profile = ROOT / "instance" / "dds" / dds_profiles.FILE_NAME  # the app's instance folder
+    profile.unlink(missing_ok=True)
     app = App(tmp_path)
     stream = camera = client = None
     try:
-        profile = ROOT / "instance" / "dds" / dds_profiles.FILE_NAME
-        assert f'profile_name="{TOPIC}"' in profile.read_text()
         stream = SseClient(app.url + "/api/events?channels=markers")  # watched: the overlay reads markers
         wait_until(lambda: flood.publish("small")["subscribers"] >= 1, 30, "the app's markers reader matched")
         stream.wait_for("markers", lambda d: len(d["markers"]) >= 1, timeout=30)
@@ -131,8 +132,9 @@ def test_a_hostile_marker_array_is_given_back_and_markers_and_large_images_still
         # A camera frame of 1280 x 720 rgb8 (2.8 MB) is over the overlay bound, and its reader is not an overlay's.
         assert 1280 * 720 * 3 > bounds.MARKERS_MAX_BYTES
         camera = ImagePublisher("/test_cam/large", width=1280, height=720, hz=5)
-        client = MjpegClient(f"{app.url}/stream?topic=/test_cam/large&viewer=large")
+        client = MjpegClient(f"{app.url}/stream?topic=/test_cam/large&viewer=large&msg_type=sensor_msgs/msg/Image")
         client.wait_frames(2, timeout=60)
+        assert f'profile_name="{TOPIC}"' in profile.read_text()  # written by the app at its start
     finally:
         for each in (client, camera, stream):
             if each is not None:
