@@ -84,8 +84,11 @@ def prepare(topics: Iterable[str], folder: Path, node_name: str,
     path = folder / FILE_NAME
     try:
         folder.mkdir(parents=True, exist_ok=True)
-        path.write_text(profiles_xml(names, env.get("RMW_FASTRTPS_PUBLICATION_MODE", "SYNCHRONOUS")),
+        # Whole or not at all: another process starting now (a second worker) may be reading it.
+        part = folder / f".{FILE_NAME}.{os.getpid()}"
+        part.write_text(profiles_xml(names, env.get("RMW_FASTRTPS_PUBLICATION_MODE", "SYNCHRONOUS")),
                         encoding="utf-8")
+        os.replace(part, path)
     except OSError as exc:  # the GUI still runs, as it did before this profile
         log.warning("could not write %s (%s): the overlay readers keep rmw's memory policy", path, exc)
         return None
