@@ -189,12 +189,15 @@ def run_markers(env: dict, markers: int) -> dict:
         fleet.poll(5.0, lambda *a: None)  # still watched: what the overlays cost afterwards
         after_pct = 100 * (server.cpu_seconds() - cpu_a) / (time.monotonic() - t_a)
         counts = requests.get(server.url + "/api/overlays", timeout=5).json()["layers"]["markers"]
-        r = {"markers": markers, "rss_growth_mb": round(m["peak_mb"] - rss0, 1), "estop_p99_ms": m["estop_p99_ms"],
+        kept = server.rss_mb() - rss0  # what stays once it is over (a reader's pool kept the sample)
+        r = {"markers": markers, "rss_growth_mb": round(m["peak_mb"] - rss0, 1), "rss_kept_mb": round(kept, 1),
+             "estop_p99_ms": m["estop_p99_ms"],
              "estop_max_ms": m["estop_max_ms"], "cpu_during_s": round(during_cpu, 2),
              "cpu_after_pct": round(after_pct, 1), "largest_frame_markers": max(sizes, default=0),
              "skipped_by_reason": counts["skipped_by_reason"]}
-        print(f"{markers} markers: RSS +{r['rss_growth_mb']} MB, e-stop p99 {r['estop_p99_ms']} ms "
-              f"(max {r['estop_max_ms']}), CPU during {r['cpu_during_s']} s, after {r['cpu_after_pct']} % of a core, "
+        print(f"{markers} markers: RSS +{r['rss_growth_mb']} MB at peak, +{r['rss_kept_mb']} MB kept, "
+              f"e-stop p99 {r['estop_p99_ms']} ms (max {r['estop_max_ms']}), CPU during {r['cpu_during_s']} s, "
+              f"after {r['cpu_after_pct']} % of a core, "
               f"largest frame {r['largest_frame_markers']} markers, skipped {r['skipped_by_reason']}", flush=True)
         return r
     finally:

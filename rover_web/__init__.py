@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Mapping
+from pathlib import Path
 from typing import Any
 
 from flask import Flask
@@ -97,6 +98,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     from rover_web import fleet as fleet_pages
     from rover_web.core.state import EXTENSION
     from rover_web.fleet import build_fleet
+    from rover_web.ros import dds_profiles
     from rover_web.ros.runtime import RosRuntime
     from rover_web.storage.claim import claim
     from rover_web.storage.db import database_path
@@ -105,6 +107,9 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
     db_path = database_path(app)
     db_claim = claim(db_path)  # before the node: a refused second server never joins the ROS graph
     try:
+        # Before the first participant: Fast DDS reads its profiles once (ros/dds_profiles.py).
+        dds_profiles.prepare(overlays.reader_topics(settings), Path(app.instance_path) / "dds",
+                             settings["ROVER_WEB_NODE_NAME"])
         runtime = RosRuntime(settings["ROVER_WEB_NODE_NAME"], settings["ROVER_WEB_ROS_DOMAIN_ID"])
     except BaseException:
         db_claim.release()

@@ -11,6 +11,8 @@ poses (pose history), counts, msgs, routes.
 
 from __future__ import annotations
 
+from rover_web.config import TOPIC_KEYS
+from rover_web.core import robots
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
 
@@ -25,6 +27,17 @@ def init_app(app, fleet: Fleet) -> None:
     for rover in fleet:
         _init_robot(rover)
     app.register_blueprint(routes.bp)
+
+
+def reader_topics(settings) -> list[str]:
+    """Every overlay topic of every robot, as _init_robot will subscribe them: read before the ROS
+    node exists, so that their DDS readers get a profile of their own (ros/dds_profiles.py)."""
+    names: list[str] = []
+    for robot in robots.parse(settings["ROVER_WEB_ROBOTS"]):
+        config = robots.settings_for(robot, settings, TOPIC_KEYS)
+        names += [config["ROVER_WEB_SCAN_TOPIC"], config["ROVER_WEB_MARKERS_TOPIC"],
+                  config["ROVER_WEB_FOOTPRINT_TOPIC"], *config["ROVER_WEB_COSTMAP_TOPICS"]]
+    return [name for name in names if name]
 
 
 def _init_robot(rover: Rover) -> None:
