@@ -1,0 +1,500 @@
+"""A transform buffer with tf2's semantics, in plain Python (no rclpy, no Flask).
+
+What tf2's BufferCore does, kept small: static transforms are kept forever (one value per child),
+dynamic ones for a cache window; a lookup walks both frames up to their common ancestor, at a
+stamp (interpolating: translation linearly, rotation by slerp, between the two neighbouring
+stamps) or at the latest time every link on the path has data (tf2's ``Time(0)``). Refusals are
+``TfError`` with tf2's reasons: unknown frame, not connected, extrapolation into the past or the
+future by how much. What tf2 ignores on insertion we ignore too (NaN, a quaternion whose squared
+norm is off 1 by more than 1e-5, a frame its own parent, data older than the window, a repeated
+stamp) and count it, so the TF page can say why a frame is missing.
+
+Why the maths is hand-written: the target is a lookup through a 10-frame chain in at most 50 µs
+(p99). Measured here (Python 3.11, numpy 2.4, scipy 1.17, a loaded 2-core machine): scipy's
+``Rotation`` costs about 9 µs to build from a quaternion and 25 µs per product, transforms3d is
+numpy calls of about 3-5 µs each; a 10-link chain through either lands at 100-300 µs. The same
+product on Python floats costs about 1 µs, and a whole 10-link lookup about 12 µs (p50). The maths
+is a dozen lines (a quaternion product, a rotation of a vector, slerp); tests/unit/tf/ checks it
+against 4x4 matrices and slerp from scipy.spatial.transform, the oracle. ``Transform.apply_many``
+is the one place numpy pays off (thousands of points), so it uses it.
+
+Thread safety: one lock around the frame table; subscription callbacks insert while request
+threads and ticks look up.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from bisect import bisect_left
+from dataclasses import dataclass
+
+import numpy as np
+
+# tf2's limits: a quaternion whose squared norm is off 1 by more than this is refused
+# (TF_DENORMALIZED_QUATERNION); a walk longer than this means a loop.
+QUATERNION_TOLERANCE = 1e-5
+MAX_GRAPH_DEPTH = 1000
+KINDS = ("unknown_frame", "not_connected", "extrapolation_past", "extrapolation_future", "invalid")
+
+Quaternion = tuple[float, float, float, float]
+Vector = tuple[float, float, float]
+
+
+class TfError(Exception):
+    """A refused lookup: ``kind`` is one of KINDS, ``message`` a tf2-like sentence, ``detail`` the figures."""
+
+    def __init__(self, kind: str, message: str, **detail) -> None:
+        super().__init__(message)
+        self.kind = kind
+        self.message = message
+        self.detail = detail
+
+
+# --- maths on tuples (see the module docstring for why not a library) -------------------------------
+
+def _qmul(a: Quaternion, b: Quaternion) -> Quaternion:
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+            aw * bw - ax * bx - ay * by - az * bz)
+
+
+def _rotate(q: Quaternion, x: float, y: float, z: float) -> Vector:
+    # v + 2w(q×v) + 2 q×(q×v): two cross products, no matrix
+    qx, qy, qz, qw = q
+    tx = 2.0 * (qy * z - qz * y)
+    ty = 2.0 * (qz * x - qx * z)
+    tz = 2.0 * (qx * y - qy * x)
+    return (x + qw * tx + (qy * tz - qz * ty),
+            y + qw * ty + (qz * tx - qx * tz),
+            z + qw * tz + (qx * ty - qy * tx))
+
+
+def _compose(ta: Vector, qa: Quaternion, tb: Vector, qb: Quaternion) -> tuple[Vector, Quaternion]:
+    """(ta, qa) ∘ (tb, qb): apply b, then a."""
+    rx, ry, rz = _rotate(qa, tb[0], tb[1], tb[2])
+    return (rx + ta[0], ry + ta[1], rz + ta[2]), _qmul(qa, qb)
+
+
+def _invert(t: Vector, q: Quaternion) -> tuple[Vector, Quaternion]:
+    qi = (-q[0], -q[1], -q[2], q[3])
+    x, y, z = _rotate(qi, t[0], t[1], t[2])
+    return (-x, -y, -z), qi
+
+
+def slerp(a: Quaternion, b: Quaternion, r: float) -> Quaternion:
+    """Spherical interpolation along the shorter arc (tf2 flips b when the dot product is negative)."""
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    dot = ax * bx + ay * by + az * bz + aw * bw
+    if dot < 0.0:
+        bx, by, bz, bw, dot = -bx, -by, -bz, -bw, -dot
+    if dot > 0.9995:
+        # nearly the same rotation: sin(theta) ~ 0, a normalised lerp is exact to 1e-8 here
+        x, y, z, w = ax + r * (bx - ax), ay + r * (by - ay), az + r * (bz - az), aw + r * (bw - aw)
+        n = math.sqrt(x * x + y * y + z * z + w * w)
+        return (x / n, y / n, z / n, w / n)
+    theta = math.acos(dot)
+    s = math.sin(theta)
+    wa = math.sin((1.0 - r) * theta) / s
+    wb = math.sin(r * theta) / s
+    return (wa * ax + wb * bx, wa * ay + wb * by, wa * az + wb * bz, wa * aw + wb * bw)
+
+
+def yaw_of(q: Quaternion) -> float:
+    x, y, z, w = q
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+@dataclass(frozen=True, slots=True)
+class Transform:
+    """Maps points given in ``source`` into ``target`` (tf2's lookupTransform(target, source))."""
+
+    translation: tuple[float, float, float]
+    rotation: tuple[float, float, float, float]  # x, y, z, w (unit)
+    stamp_ns: int = 0
+
+    @classmethod
+    def identity(cls, stamp_ns: int = 0) -> Transform:
+        return cls((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0), stamp_ns)
+
+    def apply(self, x: float, y: float, z: float = 0.0) -> tuple[float, float, float]:
+        rx, ry, rz = _rotate(self.rotation, x, y, z)
+        t = self.translation
+        return (rx + t[0], ry + t[1], rz + t[2])
+
+    def matrix(self) -> np.ndarray:
+        """The 3x3 rotation matrix (for callers that transform many points themselves)."""
+        x, y, z, w = self.rotation
+        return np.array((
+            (1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)),
+            (2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)),
+            (2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)),
+        ))
+
+    def apply_many(self, xs, ys, zs=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        xs = np.asarray(xs, dtype=float)
+        ys = np.asarray(ys, dtype=float)
+        zs = np.zeros_like(xs) if zs is None else np.asarray(zs, dtype=float)
+        m = self.matrix()
+        t = self.translation
+        return (m[0, 0] * xs + m[0, 1] * ys + m[0, 2] * zs + t[0],
+                m[1, 0] * xs + m[1, 1] * ys + m[1, 2] * zs + t[1],
+                m[2, 0] * xs + m[2, 1] * ys + m[2, 2] * zs + t[2])
+
+    @property
+    def yaw(self) -> float:
+        return yaw_of(self.rotation)
+
+    def inverse(self) -> Transform:
+        t, q = _invert(self.translation, self.rotation)
+        return Transform(t, q, self.stamp_ns)
+
+    def compose(self, other: Transform) -> Transform:
+        """self ∘ other: ``other`` first. The stamp is self's."""
+        t, q = _compose(self.translation, self.rotation, other.translation, other.rotation)
+        return Transform(t, q, self.stamp_ns)
+
+
+# --- the frame table ---------------------------------------------------------------------------------
+
+class _Frame:
+    """One child frame: its parent, and either one static value or a window of stamped values."""
+
+    __slots__ = ("name", "parent", "static", "stamps", "values", "authority", "parents", "received",
+                 "unnormalised", "last_norm2")
+
+    def __init__(self, name: str, parent: str, static: bool) -> None:
+        self.name = name
+        self.parent = parent
+        self.static = static
+        self.stamps: list[int] = []                       # sorted
+        self.values: list[tuple[Vector, Quaternion]] = []  # parallel to stamps
+        self.authority = ""
+        # parent -> (authority, monotonic ns last heard): a second parent heard recently is a conflict
+        self.parents: dict[str, tuple[str, int]] = {}
+        self.received = 0
+        self.unnormalised = 0
+        self.last_norm2 = 1.0
+
+    def newest(self) -> int:
+        return self.stamps[-1] if self.stamps else 0
+
+    def at(self, stamp_ns: int) -> tuple[Vector, Quaternion] | None | tuple[str, int]:
+        """The value at a stamp, interpolated; or ("past"|"future", nearest stamp)."""
+        stamps = self.stamps
+        if self.static or stamp_ns == 0:
+            return self.values[-1]
+        i = bisect_left(stamps, stamp_ns)
+        n = len(stamps)
+        if i < n and stamps[i] == stamp_ns:
+            return self.values[i]
+        if i == 0:
+            return ("past", stamps[0])
+        if i == n:
+            return ("future", stamps[-1])
+        s0, s1 = stamps[i - 1], stamps[i]
+        (t0, q0), (t1, q1) = self.values[i - 1], self.values[i]
+        r = (stamp_ns - s0) / (s1 - s0)
+        return ((t0[0] + r * (t1[0] - t0[0]), t0[1] + r * (t1[1] - t0[1]), t0[2] + r * (t1[2] - t0[2])),
+                slerp(q0, q1, r))
+
+
+def clean_frame_id(frame: str) -> str:
+    # tf2 strips a leading "/" (a ROS 1 habit) and warns; frame ids compare without it
+    return frame[1:] if frame.startswith("/") else frame
+
+
+class TfBuffer:
+    def __init__(self, cache_s: float = 10.0, *, conflict_s: float = 5.0) -> None:
+        self._cache_ns = int(cache_s * 1e9)
+        self._conflict_ns = int(conflict_s * 1e9)
+        self._lock = threading.Lock()
+        self._frames: dict[str, _Frame] = {}
+        self._parent_names: set[str] = set()  # every frame ever named as a parent: roots are known frames too
+        self.rejected: dict[str, int] = {}  # reason -> count (what tf2 logs and drops)
+        self.last_rejection: dict[str, str] = {}  # reason -> a sentence about the latest one
+
+    @property
+    def cache_s(self) -> float:
+        return self._cache_ns / 1e9
+
+    # --- insertion ---
+
+    def _reject(self, reason: str, sentence: str) -> bool:
+        self.rejected[reason] = self.rejected.get(reason, 0) + 1
+        self.last_rejection[reason] = sentence
+        return False
+
+    def set_transform(self, parent: str, child: str, translation, rotation, stamp_ns: int, *, static: bool,
+                      authority: str = "") -> bool:
+        """Insert ``parent`` → ``child`` (maps child points into parent). False when refused, as tf2 refuses."""
+        parent = clean_frame_id(parent)
+        child = clean_frame_id(child)
+        tx, ty, tz = (float(v) for v in translation)
+        qx, qy, qz, qw = (float(v) for v in rotation)
+        stamp_ns = int(stamp_ns)
+        with self._lock:
+            if not child or not parent:
+                return self._reject("no_frame_id", f"a transform from [{parent}] to [{child}] has an empty frame id")
+            if child == parent:
+                return self._reject("self_transform", f"frame [{child}] given as its own parent")
+            if not all(map(math.isfinite, (tx, ty, tz, qx, qy, qz, qw))):
+                return self._reject("nan", f"a transform from [{parent}] to [{child}] holds NaN or infinity")
+            norm2 = qx * qx + qy * qy + qz * qz + qw * qw
+            frame = self._frames.get(child)
+            if frame is None:
+                frame = self._frames[child] = _Frame(child, parent, static)
+            frame.received += 1
+            frame.last_norm2 = norm2
+            now = time.monotonic_ns()
+            frame.parents[parent] = (authority, now)
+            self._parent_names.add(parent)
+            if abs(norm2 - 1.0) > QUATERNION_TOLERANCE:
+                frame.unnormalised += 1
+                return self._reject("unnormalised", f"the quaternion of [{child}] (parent [{parent}]) has norm "
+                                                    f"{math.sqrt(norm2):.6f}")
+            value = ((tx, ty, tz), (qx, qy, qz, qw))
+            if frame.parent != parent:
+                # re-parented (or a second publisher fighting over it): the old window is relative to
+                # another frame, so interpolating across the change would be wrong
+                frame.parent = parent
+                frame.stamps.clear()
+                frame.values.clear()
+            frame.authority = authority
+            if static or frame.static:
+                frame.static = True
+                frame.stamps[:] = [stamp_ns]
+                frame.values[:] = [value]
+                return True
+            stamps = frame.stamps
+            if stamps and stamp_ns >= stamps[-1]:
+                if stamp_ns == stamps[-1]:
+                    return self._reject("repeated", f"repeated stamp {stamp_ns / 1e9:.6f} for [{child}]")
+                stamps.append(stamp_ns)
+                frame.values.append(value)
+            else:
+                if stamps and stamp_ns < stamps[-1] - self._cache_ns:
+                    return self._reject("old_data", f"data for [{child}] at {stamp_ns / 1e9:.6f} is older than the "
+                                                    f"cache ({self.cache_s:g} s)")
+                i = bisect_left(stamps, stamp_ns)
+                if i < len(stamps) and stamps[i] == stamp_ns:
+                    return self._reject("repeated", f"repeated stamp {stamp_ns / 1e9:.6f} for [{child}]")
+                stamps.insert(i, stamp_ns)
+                frame.values.insert(i, value)
+            cut = stamps[-1] - self._cache_ns
+            if stamps[0] < cut:
+                k = bisect_left(stamps, cut)
+                del stamps[:k]
+                del frame.values[:k]
+            return True
+
+    def clear(self) -> None:
+        with self._lock:
+            self._frames.clear()
+            self._parent_names.clear()
+            self.rejected.clear()
+            self.last_rejection.clear()
+
+    # --- lookups ---
+
+    def _chain(self, frame: str) -> list[_Frame]:
+        """The frames from ``frame`` up to its root (the root itself, a parent only, is not in the list)."""
+        chain = []
+        f = self._frames.get(frame)
+        while f is not None and f.values:  # a frame whose every transform was refused has no link
+            chain.append(f)
+            if len(chain) > MAX_GRAPH_DEPTH:
+                raise TfError("invalid", f"The tf tree is invalid because it contains a loop (walking up from "
+                                         f"[{frame}]).", frame=frame)
+            f = self._frames.get(f.parent)
+        return chain
+
+    def _known(self, frame: str) -> bool:
+        f = self._frames.get(frame)
+        return (f is not None and bool(f.values)) or frame in self._parent_names
+
+    def lookup(self, target: str, source: str, stamp_ns: int | None = None) -> Transform:
+        """The transform mapping ``source`` points into ``target`` at ``stamp_ns`` (None/0: the latest common time)."""
+        target = clean_frame_id(target)
+        source = clean_frame_id(source)
+        stamp = int(stamp_ns or 0)
+        if stamp < 0:
+            raise TfError("invalid", f"Requested time {stamp / 1e9:.6f} is negative", stamp_ns=stamp)
+        with self._lock:
+            for arg, name in (("target_frame", target), ("source_frame", source)):
+                if not name:
+                    raise TfError("invalid", f"Invalid argument passed to lookupTransform argument {arg} - "
+                                             "frame id is empty", argument=arg)
+                if not self._known(name):
+                    raise TfError("unknown_frame", f'"{name}" passed to lookupTransform argument {arg} does not '
+                                                   "exist.", frame=name, argument=arg)
+            if target == source:
+                return Transform.identity(stamp)
+            up_s = self._chain(source)
+            up_t = self._chain(target)
+            # the common ancestor: the first frame on source's way up that target's way up also passes
+            t_names = {target: -1}
+            for i, f in enumerate(up_t):
+                t_names[f.parent] = i
+            s_len = None
+            if source in t_names:
+                s_len, t_len = 0, t_names[source] + 1
+            else:
+                for i, f in enumerate(up_s):
+                    if f.parent in t_names:
+                        s_len, t_len = i + 1, t_names[f.parent] + 1
+                        break
+            if s_len is None:
+                raise TfError("not_connected", f"Could not find a connection between '{target}' and '{source}' "
+                                               "because they are not part of the same tree. Tf has two or more "
+                                               "unconnected trees.", target=target, source=source)
+            links = up_s[:s_len] + up_t[:t_len]
+            if stamp == 0:
+                stamp = self._latest_common(links)
+            values = []
+            for f in links:
+                v = f.at(stamp)
+                if isinstance(v[0], str):
+                    raise self._extrapolation(v[0], stamp, v[1], f, target, source)
+                values.append(v)
+        # composition outside the lock: values are immutable tuples
+        ts, qs = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)
+        for i in range(s_len - 1, -1, -1):        # source's chain, from the ancestor's child down
+            t, q = values[i]
+            ts, qs = _compose(ts, qs, t, q) if i != s_len - 1 else (t, q)
+        tt, qt = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)
+        for i in range(len(values) - 1, s_len - 1, -1):
+            t, q = values[i]
+            tt, qt = _compose(tt, qt, t, q) if i != len(values) - 1 else (t, q)
+        ti, qi = _invert(tt, qt)
+        t, q = _compose(ti, qi, ts, qs)
+        return Transform(t, q, stamp)
+
+    @staticmethod
+    def _latest_common(links: list[_Frame]) -> int:
+        # tf2's getLatestCommonTime: the oldest of the newest stamps of the dynamic links; 0 when all static
+        common = 0
+        for f in links:
+            if not f.static and f.stamps:
+                n = f.stamps[-1]
+                if common == 0 or n < common:
+                    common = n
+        return common
+
+    @staticmethod
+    def _extrapolation(direction: str, stamp: int, nearest: int, frame: _Frame, target: str, source: str) -> TfError:
+        by = abs(stamp - nearest) / 1e9
+        edge = "earliest" if direction == "past" else "latest"
+        return TfError(
+            f"extrapolation_{direction}",
+            f"Lookup would require extrapolation {by:.3f} s into the {direction}. Requested time {stamp / 1e9:.6f} "
+            f"but the {edge} data is at time {nearest / 1e9:.6f}, when looking up transform from frame "
+            f"[{source}] to frame [{target}]",
+            by_s=by, frame=frame.name, requested_ns=stamp, nearest_ns=nearest)
+
+    def can_transform(self, target: str, source: str, stamp_ns: int | None = None) -> bool:
+        try:
+            self.lookup(target, source, stamp_ns)
+        except TfError:
+            return False
+        return True
+
+    # --- the tree, for /api/tf ---
+
+    def frames(self, now_ns: int | None = None, *, stale_s: float = 1.0, future_s: float = 0.1) -> dict:
+        """A snapshot of the tree and what is wrong with it.
+
+        ``now_ns`` is the clock stamps are judged against (the node's clock; a recording's end for a
+        replay); a dynamic frame whose newest stamp is older than ``max(stale_s, 5 periods)`` is stale.
+        """
+        now = time.time_ns() if now_ns is None else int(now_ns)
+        mono = time.monotonic_ns()
+        with self._lock:
+            frames = list(self._frames.values())
+            known = {f.name for f in frames}
+            rows: dict[str, dict] = {}
+            warnings: list[dict] = []
+            for f in frames:
+                n = len(f.stamps)
+                newest = f.stamps[-1] if n else None
+                rate = None
+                if not f.static and n >= 2 and f.stamps[-1] > f.stamps[0]:
+                    rate = (n - 1) / ((f.stamps[-1] - f.stamps[0]) / 1e9)
+                age = (now - newest) / 1e9 if newest is not None else None
+                others = sorted((p, a) for p, (a, seen) in f.parents.items()
+                                if p != f.parent and mono - seen <= self._conflict_ns)
+                rows[f.name] = {
+                    "parent": f.parent, "static": f.static, "rate_hz": rate,
+                    "newest_stamp": newest / 1e9 if newest is not None else None,
+                    "oldest_stamp": f.stamps[0] / 1e9 if n else None,
+                    "age_s": None if f.static else age, "authority": f.authority,
+                    "received": f.received, "unnormalised": f.unnormalised,
+                }
+                if others:
+                    warnings.append({
+                        "kind": "two_parents", "frame": f.name,
+                        "parents": [{"parent": f.parent, "authority": f.authority}]
+                        + [{"parent": p, "authority": a} for p, a in others],
+                        "message": f"[{f.name}] is published with more than one parent: "
+                                   + ", ".join([f"[{f.parent}] by {f.authority or '?'}"]
+                                               + [f"[{p}] by {a or '?'}" for p, a in others])})
+                if f.unnormalised and abs(f.last_norm2 - 1.0) > QUATERNION_TOLERANCE:
+                    warnings.append({
+                        "kind": "unnormalised", "frame": f.name, "norm": math.sqrt(f.last_norm2),
+                        "message": f"[{f.name}]'s quaternion has norm {math.sqrt(f.last_norm2):.6f}: tf2 ignores "
+                                   "such transforms"})
+                if not f.static and age is not None:
+                    limit = max(stale_s, 5.0 / rate) if rate else stale_s
+                    if age > limit:
+                        warnings.append({"kind": "stale", "frame": f.name, "age_s": age,
+                                         "message": f"[{f.name}]'s newest transform is {age:.2f} s old"})
+                    elif age < -future_s:
+                        warnings.append({
+                            "kind": "future", "frame": f.name, "ahead_s": -age,
+                            "message": f"[{f.name}] is stamped {-age:.2f} s in the future: the clocks of the "
+                                       "robot and this server disagree"})
+            for name in {f.parent for f in frames} - known:
+                rows[name] = {"parent": None, "static": None, "rate_hz": None, "newest_stamp": None,
+                              "oldest_stamp": None, "age_s": None, "authority": "", "received": 0,
+                              "unnormalised": 0}
+            loops = _loops({f.name: f.parent for f in frames})
+            for loop in loops:
+                warnings.append({"kind": "loop", "frames": loop,
+                                 "message": "the tree has a loop: " + " → ".join(f"[{x}]" for x in loop + loop[:1])})
+            in_loop = {x for loop in loops for x in loop}
+            roots = sorted(name for name, row in rows.items() if row["parent"] is None)
+            if len(roots) > 1:
+                warnings.append({"kind": "several_trees", "roots": roots,
+                                 "message": f"{len(roots)} unconnected trees (roots "
+                                            + ", ".join(f"[{r}]" for r in roots)
+                                            + "): lookups between them fail"})
+            for name, row in rows.items():
+                row["children"] = sorted(c for c, r in rows.items() if r["parent"] == name)
+                row["in_loop"] = name in in_loop
+            rejected = [{"reason": r, "count": c, "message": self.last_rejection.get(r, "")}
+                        for r, c in sorted(self.rejected.items())]
+        return {"frames": rows, "roots": roots, "warnings": warnings, "rejected": rejected,
+                "now": now / 1e9, "cache_s": self.cache_s}
+
+
+def _loops(parent_of: dict[str, str]) -> list[list[str]]:
+    """Each cycle of the child → parent map once, starting at its smallest name."""
+    done: set[str] = set()
+    loops = []
+    for start in parent_of:
+        path: dict[str, int] = {}
+        node = start
+        while node in parent_of and node not in done and node not in path:
+            path[node] = len(path)
+            node = parent_of[node]
+        if node in path:
+            cycle = list(path)[path[node]:]
+            i = cycle.index(min(cycle))
+            loops.append(cycle[i:] + cycle[:i])
+        done.update(path)
+    return loops
