@@ -60,6 +60,13 @@ class Planar:
         return self.x + c * xs - s * ys, self.y + s * xs + c * ys, np.zeros_like(xs) if zs is None else zs
 
 
+    def compose_2d(self, pose: tuple[float, float, float]) -> Planar:
+        """self ∘ pose: a pose given in this frame (a laser's configured offset on the robot)."""
+        x, y, _ = self.apply(pose[0], pose[1])
+        yaw = self.yaw + pose[2]
+        return Planar(x, y, math.atan2(math.sin(yaw), math.cos(yaw)))
+
+
 IDENTITY = Planar(0.0, 0.0, 0.0)
 
 
@@ -95,7 +102,8 @@ class MapPlacer:
             return self.buffer.lookup(self.map_frame, frame, stamp_ns(stamp_s) or None)
         except TfError as exc:
             error = exc
-        if error.kind == "extrapolation_future" and float(error.detail.get("by_s", math.inf)) <= self.future_tolerance_s:
+        ahead_s = float(error.detail.get("by_s", math.inf))
+        if error.kind == "extrapolation_future" and ahead_s <= self.future_tolerance_s:
             try:
                 return self.buffer.lookup(self.map_frame, frame, None)
             except TfError as exc:
