@@ -41,6 +41,8 @@ FOOTPRINT_MAX_HZ = 5.0
 COSTMAP_CHECK_S = 0.05  # how often the encoding loop looks for a new grid: the most it adds to a grid's age
 FOOTPRINT_MAX_POINTS = 200
 CHANNELS = ("scan", "costmap", "markers", "footprint")
+AMCL_QUIET_S = 2.0  # no AMCL pose this long: the robot's pose history is fed from TF's map -> base_link
+TF_POSE_S = 0.1  # how often then
 
 
 def laser_offset(config: dict[str, Any]) -> tuple[float, float, float]:
@@ -74,6 +76,9 @@ class OverlayService:
         self.placer = MapPlacer(tf_buffer(rover) if hasattr(rover, "feature") else None,
                                 config.get("ROVER_WEB_MAP_FRAME", "map"))
         self.map_frames.add(self.placer.map_frame)
+        self.base_frame = config.get("ROVER_WEB_BASE_FRAME", "base_link")
+        self._amcl_at = -math.inf
+        self._tf_stamp: int | None = None
         self.poses = PoseHistory(keep_s=config["ROVER_WEB_LIVEMAP_TRAIL_S"])
         self.odom_frame = OdomInMap()
         self.counts = {
@@ -96,8 +101,24 @@ class OverlayService:
 
     def on_pose(self, stamp: float, x: float, y: float, yaw: float) -> None:
         if all(map(math.isfinite, (stamp, x, y, yaw))):
+            self._amcl_at = time.monotonic()
             self.poses.add(stamp, x, y, yaw)
             self.odom_frame.on_map_pose(stamp, (x, y, yaw))
+
+    def pose_from_tf(self) -> None:
+        """One tick: with AMCL quiet, the recent path (and the fallback's robot) from TF's map -> base_link."""
+        buffer = self.placer.buffer
+        if buffer is None or time.monotonic() - self._amcl_at < AMCL_QUIET_S:
+            return
+        from rover_web.tf.buffer import TfError
+
+        try:
+            t = buffer.lookup(self.placer.map_frame, self.base_frame, None)
+        except TfError:
+            return
+        if t.stamp_ns != self._tf_stamp:
+            self._tf_stamp = t.stamp_ns
+            self.poses.add(t.stamp_ns / 1e9, t.translation[0], t.translation[1], t.yaw)
 
     def on_odom(self, raw: bytes) -> None:
         """The odometry's pose, for placing grids and footprints given in its frame (frames.py)."""
