@@ -85,6 +85,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         scan_the_code,
         telemetry,
         teleop,
+        tf,
         topics,
         waypoints,
     )
@@ -111,6 +112,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         auth.init_app(app, graph)  # first: every route after it is checked for sign-in and role
         estop.init_app(app, fleet)  # before every feature that moves the robot: they gate on it
         geofence.init_app(app, fleet)  # before waypoints and livemap: they check it before publishing
+        tf.init_app(app, fleet)  # the frames: before livemap, overlays and GPS, which place things through it
         # Features, in dashboard order of their cards; each registers its routes once and sets up
         # every robot (a fleet) or the graph-wide scope (graph) it serves.
         telemetry.init_app(app, fleet)

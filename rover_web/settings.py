@@ -198,6 +198,16 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("PANELS_LOG_SHOWN", 20, "int", "operator-log entries a panel page shows (newest first)", 1, 500),
     Setting("PANELS_LOG_KEEP", 10000, "int", "operator-log entries kept per panel in the database (oldest deleted)",
             100, 10_000_000),
+    # --- TF: the robot's frames (docs/tf.md) ---
+    Setting("TF_CACHE_S", 10.0, "float",
+            "how long dynamic transforms (/tf) are kept for lookups at past stamps, as tf2's cache; static ones "
+            "(/tf_static) are kept forever", 0.5, 600),
+    Setting("TF_STALE_S", 1.0, "float",
+            "the TF page warns of a dynamic frame whose newest transform is older than this (or than five of its "
+            "periods, if longer)", 0.05, 3600),
+    Setting("MAP_FRAME", "map", "str", "the fixed world frame (REP 105's map)"),
+    Setting("ODOM_FRAME", "odom", "str", "the odometry frame (REP 105's odom)"),
+    Setting("BASE_FRAME", "base_link", "str", "the robot's body frame (REP 105's base_link)"),
     # --- livemap ---
     Setting("MAPS_FILE", "map_files/all_maps.json", "optional_str",
             "floorplans: an all_maps.json catalog or one map_server yaml (relative paths from the repository "

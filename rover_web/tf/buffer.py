@@ -440,9 +440,8 @@ class TfBuffer:
                         "kind": "two_parents", "frame": f.name,
                         "parents": [{"parent": f.parent, "authority": f.authority}]
                         + [{"parent": p, "authority": a} for p, a in others],
-                        "message": f"[{f.name}] is published with more than one parent: "
-                                   + ", ".join([f"[{f.parent}] by {f.authority or '?'}"]
-                                               + [f"[{p}] by {a or '?'}" for p, a in others])})
+                        "message": f"[{f.name}] is published with more than one parent (the newest wins): "
+                                   + ", ".join(_by(p, a) for p, a in [(f.parent, f.authority), *others])})
                 if f.unnormalised and abs(f.last_norm2 - 1.0) > QUATERNION_TOLERANCE:
                     warnings.append({
                         "kind": "unnormalised", "frame": f.name, "norm": math.sqrt(f.last_norm2),
@@ -480,6 +479,10 @@ class TfBuffer:
                         for r, c in sorted(self.rejected.items())]
         return {"frames": rows, "roots": roots, "warnings": warnings, "rejected": rejected,
                 "now": now / 1e9, "cache_s": self.cache_s}
+
+
+def _by(parent: str, authority: str) -> str:
+    return f"[{parent}] by {authority}" if authority else f"[{parent}]"
 
 
 def _loops(parent_of: dict[str, str]) -> list[list[str]]:
