@@ -5,6 +5,10 @@ serialized message), at its recorded log time relative to the first one, divided
 runs its own rclpy context and node (the CLI never starts the app's), so a team can rehearse with
 real data and no robot. The audit channel (/rover_web/audit) is only replayed when named in --topics:
 it was never a ROS topic.
+
+/tf_static goes out transient local, as tf2's static broadcaster sends it: a TF listener subscribes
+it transient local and would never match a volatile publisher, so a replayed robot's mounts (its
+laser's, its antenna's) reach the server and its scans are placed through them.
 """
 
 from __future__ import annotations
@@ -17,6 +21,11 @@ from flask import Flask, current_app
 
 NODE_NAME = "rover_web_replay"
 AUDIT_TOPIC = "/rover_web/audit"
+STATIC_TF_DEPTH = 100  # every static broadcaster's message kept for a listener that joins late
+
+
+def _qos(topic: str) -> dict:
+    return {"qos": "latched", "depth": STATIC_TF_DEPTH} if topic.rsplit("/", 1)[-1] == "tf_static" else {}
 
 
 def init_cli(app: Flask) -> None:
@@ -77,7 +86,7 @@ class _Player:
             self._skipped.add(channel.topic)
             return None
         try:
-            publisher = self.ros.publisher(schema.name, channel.topic)
+            publisher = self.ros.publisher(schema.name, channel.topic, **_qos(channel.topic))
         except UnknownMessageType as exc:
             click.echo(f"skipping {channel.topic}: {exc}", err=True)
             self._skipped.add(channel.topic)

@@ -27,10 +27,17 @@ class RawPublisherNode:
         self.node = rclpy.create_node(node_name, context=self.context, start_parameter_services=False)
         self._publishers: list = []
 
-    def publisher(self, type_name: str, topic: str, depth: int = 10):
+    def publisher(self, type_name: str, topic: str, depth: int = 10, qos: str | None = None):
         """A publisher whose publish(bytes) sends them as the serialized message; UnknownMessageType
-        when the type's Python package is not installed."""
-        publisher = self.node.create_publisher(message_class(type_name), topic, depth)
+        when the type's Python package is not installed. `qos`: a named profile (ros/qos.py) instead."""
+        from . import qos as profiles
+
+        if qos is None:
+            profile = depth
+        else:
+            profile = profiles.profile(qos, depth)
+            profile.depth = depth  # the named profiles fix their own depth ("latched" keeps 1)
+        publisher = self.node.create_publisher(message_class(type_name), topic, profile)
         self._publishers.append(publisher)
         return publisher
 
