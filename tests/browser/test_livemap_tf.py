@@ -72,3 +72,54 @@ def test_a_slam_robot_with_no_amcl_pose_is_drawn_where_tf_puts_it(live_server, p
     got = peer.wait_for("/goal_pose", lambda m: m["pose"]["position"]["x"] == 24.0)
     assert got["msg"]["header"]["frame_id"] == "map"
     assert page.watch.console_errors == []
+
+
+SCAN_RGB = (255, 59, 48)
+
+
+def test_a_scan_through_tf_shows_its_nearest_returns_filled_and_a_far_one_hollow(live_server, page, ros_peer):
+    peer = ros_peer("scan_tf_peer")
+    peer.advertise("/tf", TF, qos=100)
+    peer.advertise("/tf_static", TF, qos="latched")
+    peer.advertise("/scan", "sensor_msgs/msg/LaserScan", qos="sensor_data")
+    # The laser 0.5 m ahead of base_link; base_link at (22.5, 8) facing +x: the laser at (23, 8).
+    peer.publish("/tf_static", {"transforms": [transform("base_link", "lidar", 0.5, 0.0, 0.0, 0.0)]})
+    open_map(page, live_server.url)
+    ranges = [float("inf")] * 720          # two beams a bin (360 bins): the bin ahead holds 2 m and 5 m
+    ranges[360], ranges[361] = 2.0, 5.0
+
+    deadline = time.monotonic() + 20
+    while True:
+        t = time.time()
+        peer.publish("/tf", {"transforms": [transform("map", "odom", 20.0, 8.0, 0.0, t),
+                                            transform("odom", "base_link", 2.5, 0.0, 0.0, t)]})
+        sec = int(t - 0.01)
+        peer.publish("/scan", {"header": {"frame_id": "lidar", "stamp": {"sec": sec, "nanosec": 0}},
+                               "angle_min": -math.pi, "angle_max": math.pi - math.pi / 360,
+                               "angle_increment": math.pi / 360, "range_min": 0.05, "range_max": 30.0,
+                               "ranges": ranges})
+        try:
+            page.wait_for_function("(() => { const l = window.liveMapState.layers;"
+                                   " return l && l.scan && l.scan.far === 1 && l.scan.placed_by === 'tf'; })()",
+                                   timeout=1000)
+            break
+        except Exception:
+            if time.monotonic() > deadline:
+                raise
+    page.wait_for_timeout(200)
+    s = state(page)
+    assert s["layers"]["scan"]["points"] == 1
+    near = expected_screen(s, 25.0, 8.0)
+    far = expected_screen(s, 28.0, 8.0)
+    assert canvas_rgb(page, near[0], near[1]) == SCAN_RGB            # the nearest: a filled dot
+    ring = page.evaluate("""([x, y]) => {
+        const c = document.getElementById('livemap-canvas');
+        const dpr = window.devicePixelRatio || 1;
+        const d = c.getContext('2d').getImageData(Math.round((x - 4) * dpr), Math.round((y - 4) * dpr), 9, 9).data;
+        let red = 0;
+        for (let i = 0; i < d.length; i += 4) if (d[i] > 200 && d[i + 1] < 120 && d[i + 2] < 120) red += 1;
+        return red;
+    }""", list(far))
+    assert ring >= 8                                                 # the farthest: an outline around it
+    assert canvas_rgb(page, far[0], far[1]) != SCAN_RGB              # hollow
+    assert page.locator("#overlay-placed-scan").inner_text() == "placed by TF"
