@@ -160,3 +160,43 @@ def test_without_tf_the_layers_say_they_were_placed_by_the_configured_offsets(li
     assert event["placed_by"] == "configured" and event["points"] == pytest.approx([12.0, 10.0])
     summary = overlays(live_server)
     assert summary["layers"]["scan"]["placed_by"] == "configured" and summary["tf"] is True
+
+
+def test_a_plan_in_odom_is_drawn_in_the_map_through_tf(live_server, tf_peer, sse_client):
+    stream = sse_client(live_server.url + "/api/events?channels=plan")
+    tf_peer.advertise("/plan", "nav_msgs/msg/Path")
+    t0 = time.time() - 2.0
+    path = {"header": {"frame_id": "odom", "stamp": stamp(t0)},
+            "poses": [{"pose": {"position": {"x": x, "y": 0.0}, "orientation": {"w": 1.0}}} for x in (0.0, 1.0)]}
+    event = publish_until(tf_peer, "/plan", path, stream, "plan", lambda d: d["points"], t0)
+    # odom's (0, 0) and (1, 0) in the map: (1, 2) and (1, 3) (odom is turned 90°).
+    assert event["placed_by"] == "tf" and event["frame_id"] == "odom"
+    assert np.array(event["points"]).ravel() == pytest.approx([1.0, 2.0, 1.0, 3.0], abs=1e-3)
+
+
+def test_the_gps_fix_is_moved_from_the_antenna_to_base_link_through_tf(live_server, ros_peer, sse_client):
+    from rover_web.sim.geodesy import geodetic_to_enu
+
+    stream = sse_client(live_server.url + "/api/events?channels=fix,heading")
+    peer = ros_peer("gps_tf_peer")
+    peer.advertise("/tf_static", TF, qos="latched")
+    # The antenna 0.5 m behind base_link and 0.2 m to its left.
+    peer.publish("/tf_static", {"transforms": [transform("base_link", "gps", (-0.5, 0.2, 0.6), (0, 0, 0, 1))]})
+    peer.advertise("/odom", "nav_msgs/msg/Odometry")               # the GPS heading topic by default
+    peer.advertise("/fix", "sensor_msgs/msg/NavSatFix", qos="sensor_data")
+    lat0, lng0 = 27.3742443, -82.4500873
+    north = {"header": {"frame_id": "odom"}, "child_frame_id": "base_link",
+             "pose": {"pose": {"orientation": {"z": math.sin(math.pi / 4), "w": math.cos(math.pi / 4)}}}}
+    fix = {"header": {"frame_id": "gps"}, "status": {"status": 0, "service": 1},
+           "latitude": lat0, "longitude": lng0, "altitude": 1.0, "position_covariance_type": 0}
+
+    def seen():
+        peer.publish("/odom", north)     # facing north (ENU yaw 90°)
+        peer.publish("/fix", fix)
+        return next((e["json"] for e in reversed(stream.of("fix")) if e["json"].get("placed_by") == "tf"), None)
+    event = wait_until(seen, timeout=15, interval=0.3, what="a fix placed through TF")
+    assert event["antenna_offset_m"] == pytest.approx([-0.5, 0.2])
+    # Facing north, the antenna is 0.5 m south and 0.2 m west of the centre: the centre is 0.5 m north
+    # and 0.2 m east of the fix.
+    east, north_m = geodetic_to_enu(event["lat"], event["lng"], lat0, lng0)
+    assert (east, north_m) == pytest.approx((0.2, 0.5), abs=0.01)
