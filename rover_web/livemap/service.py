@@ -17,7 +17,7 @@ from typing import Any
 from rover_web.config import ConfigError
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
-from rover_web.placement import CONFIGURED, MAP, TF, MapPlacer, Unplaceable, tf_buffer
+from rover_web.placement import MAP, TF, MapPlacer, Unplaceable, tf_buffer
 
 from . import msgs
 from .geometry import MapGeometry, wrap_angle
@@ -34,6 +34,7 @@ LIVE_MAP_MAX_HZ = 1.0
 STALE_CHECK_S = 0.2
 AMCL_QUIET_S = 2.0  # AMCL's pose this old (or none): the robot is placed by TF's map -> base_link
 TF_POSE_MIN_PERIOD_S = 0.05
+UNPLACED = "unplaced"  # a plan in a frame TF does not know: drawn as given (there is no fallback for it)
 
 
 class OutsideMap(ValueError):
@@ -176,7 +177,7 @@ class LiveMapService:
                 xs, ys, _ = placement.apply_many([p[0] for p in points], [p[1] for p in points], None)
                 points, placed_by = list(zip(xs.tolist(), ys.tolist(), strict=True)), TF
             else:
-                placed_by = CONFIGURED
+                placed_by = UNPLACED
         self.plan_placed_by = placed_by
         payload = {**plan_payload(frame_id, points, self.plan_max_points), "placed_by": placed_by}
         self.track.set_plan(payload)

@@ -1,4 +1,5 @@
-"""A simulated differential-drive rover: integrates cmd_vel, publishes odom, amcl_pose and fix.
+"""A simulated differential-drive rover: integrates cmd_vel, publishes odom, amcl_pose, fix and its
+frames on tf and tf_static (frames.py: map -> odom -> base_link, and its sensors' mounts).
 
 Topic names are relative, so in the root namespace they are /cmd_vel, /odom, ... and in a robot's
 namespace (`--robots`) /boat/cmd_vel, /boat/odom, ...
@@ -8,7 +9,8 @@ map pose laid on a local tangent plane around a configurable origin (by default 
 Benderson Park, Sarasota, FL, where RobotX is held).
 
 It starts on the first floorplan of map_files/all_maps.json (at that map's first waypoint), jumps
-to an initial pose on /initialpose (as AMCL would re-localise; it has no odometry drift), and
+to an initial pose on /initialpose (as AMCL would re-localise: map -> odom moves, odometry stays
+continuous; it has no odometry drift), and
 drives itself to a goal received on /goal_pose (frame `map`) with a simple turn-and-drive
 controller, publishing a straight-line /plan while it goes, and stops there. The operator always
 wins: any /cmd_vel message, a stop included, cancels the goal, as a stop button would on a
