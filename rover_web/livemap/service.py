@@ -33,7 +33,7 @@ PLAN_MAX_HZ = 5.0
 LIVE_MAP_MAX_HZ = 1.0
 STALE_CHECK_S = 0.2
 AMCL_QUIET_S = 2.0  # AMCL's pose this old (or none): the robot is placed by TF's map -> base_link
-TF_POSE_MIN_PERIOD_S = 0.05
+TF_POSE_MIN_PERIOD_S = 0.1  # the robot from TF at most 10 times a second: a loop's wake-ups cost even idle
 UNPLACED = "unplaced"  # a plan in a frame TF does not know: drawn as given (there is no fallback for it)
 
 

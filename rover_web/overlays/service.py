@@ -42,7 +42,7 @@ COSTMAP_CHECK_S = 0.05  # how often the encoding loop looks for a new grid: the 
 FOOTPRINT_MAX_POINTS = 200
 CHANNELS = ("scan", "costmap", "markers", "footprint")
 AMCL_QUIET_S = 2.0  # no AMCL pose this long: the robot's pose history is fed from TF's map -> base_link
-TF_POSE_S = 0.1  # how often then
+TF_POSE_S = 0.2  # how often then (the path keeps a point per 5 cm: 5 a second is plenty)
 
 
 def laser_offset(config: dict[str, Any]) -> tuple[float, float, float]:
