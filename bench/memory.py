@@ -14,6 +14,7 @@ heavy optional ones the idle app has mapped (read from /proc/<pid>/maps), i.e. l
 from __future__ import annotations
 
 import argparse
+import json
 import statistics
 import subprocess
 import sys
@@ -21,6 +22,9 @@ import time
 
 import psutil
 from common import Server, machine, ros_env, stop_process
+
+# Issue 32: idle RSS held to the floor (an rclpy node spinning, Flask imported) plus this much.
+FLOOR_ALLOWANCE_MB = 20.0
 
 FLOOR = """
 import os, signal, threading, time
@@ -78,14 +82,23 @@ def main() -> None:
     args = parser.parse_args()
     print(machine(), flush=True)
     rows = [("rover_web, defaults", {}), ("rover_web, no floorplans", {"ROVER_WEB_MAPS_FILE": ""})]
+    medians = {}
     for label, extra in rows:
         runs = [app_rss(ros_env(**extra), args.settle_s) for _ in range(args.starts)]
         rss = [r for r, _ in runs]
+        medians[label] = statistics.median(rss)
         print(f"{label:28s} RSS median {statistics.median(rss):6.1f} MB  (runs {', '.join(f'{r:.1f}' for r in rss)})"
               f"  optional libraries loaded: {', '.join(runs[-1][1]) or 'none'}", flush=True)
     floors = [floor_rss(ros_env(), args.settle_s) for _ in range(args.starts)]
     print(f"{'floor: rclpy node + Flask':28s} RSS median {statistics.median(floors):6.1f} MB  "
           f"(runs {', '.join(f'{r:.1f}' for r in floors)})", flush=True)
+    # Issue 32's target, as the stack allows it: what rover_web adds over an rclpy node with Flask.
+    floor = statistics.median(floors)
+    for label, rss in medians.items():
+        print(f"target {label}: floor + {rss - floor:.1f} MB (<= floor + {FLOOR_ALLOWANCE_MB:.0f} MB: "
+              f"{'met' if rss - floor <= FLOOR_ALLOWANCE_MB else 'NOT met'})", flush=True)
+    print(json.dumps({"floor_mb": round(floor, 1), **{k: round(v, 1) for k, v in medians.items()},
+                      "allowance_mb": FLOOR_ALLOWANCE_MB}))
 
 
 if __name__ == "__main__":

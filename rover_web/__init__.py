@@ -127,6 +127,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         topics.init_app(app, graph)
         logs.init_app(app, graph)
         diagnostics.init_app(app, fleet)
+        tf.add_nav(fleet)  # the TF page's link beside Diagnostics (tf itself is set up first, above)
         plot.init_app(app, graph)  # after topics: plots share its subscriptions
         ros_admin.init_app(app, graph)
         layouts.init_app(app, fleet)  # the dashboard's cards: after every feature that has one

@@ -33,6 +33,10 @@ if [[ ! -f "$stamp" || "$(cat "$stamp")" != "$digest" ]]; then
   echo "$digest" > "$stamp"
 fi
 
+# tf2_msgs and nav2_msgs have no wheel: built once from interfaces/ with ROS 2's own generators
+# (skipped when a sourced ROS 2 install has them, and while interfaces/ is unchanged).
+scripts/build_interfaces.sh .venv
+
 if (( want_browser )) && { [[ ! -x /usr/bin/chromium ]] || [[ ! -e /usr/lib/x86_64-linux-gnu/faketime/libfaketimeMT.so.1 ]]; }; then
   echo "== installing Debian's chromium and faketime for the tests"
   sudo_cmd=()

@@ -24,8 +24,8 @@ from rover_web.core.state import Rover
 
 from . import routes
 from .cli import init_cli
-from .identity import Anonymous, SignedIn, current_credential, current_identity, may, signed_in_name
-from .revocation import Credential, Registration, on_revoke
+from .identity import Anonymous, SignedIn, current_credential, current_identity, may, on_revoke, signed_in_name
+from .revocation import Credential, Registration
 from .routes import require_role
 from .service import AuthService, secret_key
 

@@ -4,8 +4,11 @@ from __future__ import annotations
 
 from flask_login import AnonymousUserMixin, UserMixin, current_user
 
+from rover_web.core.state import current_feature
+
 from .policy import role_allows
-from .revocation import Credential
+from .revocation import NOTHING_TO_REVOKE, CloseFn, Credential, Registration
+from .service import AuthService
 
 
 class SignedIn(UserMixin):
@@ -48,3 +51,12 @@ def may(role: str, sign_in_on: bool) -> bool:
     if not sign_in_on:
         return True
     return current_user.is_authenticated and role_allows(current_user.role, role)
+
+
+def on_revoke(close: CloseFn) -> Registration:
+    """Register the current request's credential with `close`; a no-op outside sign-in."""
+    auth = current_feature(AuthService)
+    credential = current_credential() if auth.sign_in_on() else None
+    if credential is None:
+        return NOTHING_TO_REVOKE
+    return auth.revocations.register(credential, close)

@@ -10,7 +10,8 @@ that ended, with a short reason. The database is the only truth, so a change mad
 `flask users ...` in another process counts too: a background loop runs `check()` every
 CHECK_PERIOD_S while anything is registered.
 
-How a feature uses it (docs/security.md#what-revocation-reaches):
+How a feature uses it (docs/security.md#what-revocation-reaches; `on_revoke` lives in identity.py,
+beside the credential it reads, so this module depends on nothing else of auth/):
 
     from rover_web.auth import on_revoke
     with on_revoke(close):       # close(reason: str), called at most once, from another thread
@@ -125,17 +126,3 @@ class Revocations:
                 log.info("revocation: closed %d stream(s) (%s)", closed,
                          "; ".join(sorted({f"{c.user}: {r}" for c, r in verdicts.items() if r})))
             return closed
-
-
-def on_revoke(close: CloseFn) -> Registration:
-    """Register the current request's credential with `close`; a no-op outside sign-in."""
-    from rover_web.core.state import current_feature
-
-    from .identity import current_credential
-    from .service import AuthService
-
-    auth = current_feature(AuthService)
-    credential = current_credential() if auth.sign_in_on() else None
-    if credential is None:
-        return NOTHING_TO_REVOKE
-    return auth.revocations.register(credential, close)

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import logging
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 from flask import current_app, has_request_context, request
 
@@ -21,7 +21,6 @@ from rover_web.core.streams import StreamLimit
 from rover_web.events.audit import AuditHub
 
 if TYPE_CHECKING:
-    from rover_web.core.fleet import Fleet
     from rover_web.events.broadcast import Broadcaster
     from rover_web.events.hub import EventHub
     from rover_web.ros.cmd_vel import CmdVelOutput
@@ -35,6 +34,19 @@ ROBOT_ENVIRON = "rover_web.robot"  # set by rover_web/fleet/prefix.py
 LOOP_JOIN_S = 2.0
 
 T = TypeVar("T")
+
+
+class Robots(Protocol):
+    """What a robot needs of the Fleet that holds it (core/fleet.py): its siblings and the graph
+    scope. A protocol, so this module does not import the one that imports it."""
+
+    graph: Rover
+    names: list[str]
+
+    def __iter__(self) -> Iterator[Rover]: ...
+    def get(self, name: str) -> Rover | None: ...
+    def shutdown(self) -> None: ...
+    def zero_all(self) -> None: ...
 
 
 class NotSetUp(RuntimeError):
@@ -65,7 +77,7 @@ class Rover:
         self.broadcaster = broadcaster  # writes every SSE stream
         self.robot = robot or Robot("robot")
         self.audit = AuditHub(self.robot.name)  # operator actions, for recordings (events/audit.py)
-        self.fleet: Fleet | None = None  # set by the Fleet that holds this robot
+        self.fleet: Robots | None = None  # set by the Fleet that holds this robot
         # SSE, MJPEG, echo and teleop sockets: one limit for the process, shared by every robot.
         self.streams = streams or StreamLimit(config["ROVER_WEB_MAX_STREAMS"])
         self.dashboard_panels: list[DashboardPanel] = []

@@ -10,7 +10,8 @@ GPS geofence (rover_web/geofence/rules.py), and refused.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
 from rover_web.geofence import OutsideGeofence
@@ -18,8 +19,9 @@ from rover_web.geofence import OutsideGeofence
 if TYPE_CHECKING:
     from shapely.geometry import Polygon
 
-# shapely is imported where an area is built or checked: a robot with no floorplans (or none with
-# keep-out areas) never loads it (issue 32: idle RSS).
+# shapely is imported where an area is checked or first used: a robot with no floorplans never loads
+# it, and one whose floorplans were checked in a child process at start (map_files.py) loads it at
+# its first goal on a map with keep-out areas (issue 32: idle RSS).
 
 MAX_POINTS = 1000
 
@@ -28,20 +30,32 @@ MAX_POINTS = 1000
 class KeepOutArea:
     name: str
     points: tuple[tuple[float, float], ...]
-    polygon: Polygon = field(repr=False, compare=False)
+
+    @cached_property
+    def polygon(self) -> Polygon:
+        """The area as a prepared shapely polygon; its validity was checked when it was read."""
+        import shapely
+        from shapely.geometry import Polygon
+
+        polygon = Polygon(self.points)
+        shapely.prepare(polygon)
+        return polygon
 
     def as_dict(self) -> dict:
         return {"name": self.name, "polygon": [list(p) for p in self.points]}
 
 
-def parse_keep_out(raw: Any, where: str) -> tuple[KeepOutArea, ...]:
-    """The areas, or ValueError naming the key (the map loader turns it into a ConfigError)."""
+def parse_keep_out(raw: Any, where: str, *, check_shape: bool = True) -> tuple[KeepOutArea, ...]:
+    """The areas, or ValueError naming the key (the map loader turns it into a ConfigError).
+
+    check_shape=False leaves out shapely's validity check, for areas already checked by the child
+    process that read the same file at start (map_files.py)."""
     if not isinstance(raw, list):
         raise ValueError(f"{where}: expected a list of {{\"name\": ..., \"polygon\": [[x, y], ...]}}")
-    return tuple(_area(item, f"{where}[{i}]") for i, item in enumerate(raw))
+    return tuple(_area(item, f"{where}[{i}]", check_shape) for i, item in enumerate(raw))
 
 
-def _area(item: Any, where: str) -> KeepOutArea:
+def _area(item: Any, where: str, check_shape: bool = True) -> KeepOutArea:
     if not isinstance(item, dict) or set(item) - {"name", "polygon"} or "polygon" not in item:
         raise ValueError(f"{where}: expected {{\"name\": ..., \"polygon\": [[x, y], ...]}}")
     name = item.get("name", "")
@@ -58,15 +72,16 @@ def _area(item: Any, where: str) -> KeepOutArea:
         points.append((float(p[0]), float(p[1])))
     if points[0] == points[-1]:
         points.pop()
-    import shapely
-    from shapely.geometry import Polygon
+    if len(points) < 3:
+        raise ValueError(f"{where}.polygon: not a simple polygon with an area (fewer than 3 distinct points)")
+    area = KeepOutArea(name, tuple(points))
+    if check_shape:
+        import shapely
 
-    polygon = Polygon(points)
-    reason = shapely.is_valid_reason(polygon)
-    if len(points) < 3 or reason != "Valid Geometry" or polygon.area <= 0:
-        raise ValueError(f"{where}.polygon: not a simple polygon with an area ({reason})")
-    shapely.prepare(polygon)
-    return KeepOutArea(name, tuple(points), polygon)
+        reason = shapely.is_valid_reason(area.polygon)
+        if reason != "Valid Geometry" or area.polygon.area <= 0:
+            raise ValueError(f"{where}.polygon: not a simple polygon with an area ({reason})")
+    return area
 
 
 def check_goal(areas: tuple[KeepOutArea, ...], map_name: str, x: float, y: float) -> None:

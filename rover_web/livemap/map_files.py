@@ -24,8 +24,11 @@ import io
 import json
 import math
 import re
+import subprocess
+import sys
 import threading
 from collections.abc import Callable
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -45,6 +48,12 @@ MAX_NAME_CHARS = 80
 _BAD_NAME = re.compile(r"[/\\\x00-\x1f\x7f]")
 MAP_SERVER_DEFAULTS = {"negate": 0, "occupied_thresh": 0.65, "free_thresh": 0.25, "mode": "trinary"}
 MODES = ("trinary", "scale", "raw")
+CHECK_TIMEOUT_S = 60.0
+
+# Image sizes (by resolved path) found by the child process that read the same catalog in full at
+# start (load_catalog_checked_apart): while set, images are not decoded again and keep-out areas are
+# not checked again here, so the server itself loads neither Pillow nor shapely until first used.
+_CHECKED_SIZES: ContextVar[dict[str, list[int]] | None] = ContextVar("checked_sizes", default=None)
 
 
 @dataclass(frozen=True)
@@ -222,6 +231,10 @@ def _image_size(path: Path, src: _Source, key: str) -> tuple[int, int]:
         raise src.error(key, f"{path.name}: expected a .png or .pgm image")
     if not path.is_file():
         raise src.error(key, f"{path} not found")
+    checked = _CHECKED_SIZES.get()
+    if checked is not None and str(path.resolve()) in checked:
+        width, height = checked[str(path.resolve())]
+        return width, height
     from PIL import Image
 
     try:
@@ -330,7 +343,8 @@ def _catalog_entry(name: str, entry: Any, root: Path, src: _Source) -> MapDefini
     definition = _catalog_map(name, entry, root, src)
     if "keep_out" in entry:
         try:
-            definition.keep_out = parse_keep_out(entry["keep_out"], f"{json.dumps(name)}.keep_out")
+            definition.keep_out = parse_keep_out(entry["keep_out"], f"{json.dumps(name)}.keep_out",
+                                                 check_shape=_CHECKED_SIZES.get() is None)
         except ValueError as exc:
             raise src.error("", str(exc)) from None
     return definition
@@ -436,6 +450,57 @@ def load_catalog(path: str | Path) -> dict[str, MapDefinition]:
         _check_name(name, src, "map")
         catalog[name] = _catalog_entry(name, entry, root, src)
     return catalog
+
+
+_checked_apart: dict[str, tuple[list, dict[str, list[int]]]] = {}  # catalog -> (files' stats, sizes)
+_checked_apart_lock = threading.Lock()
+
+
+def load_catalog_checked_apart(path: str | Path) -> dict[str, MapDefinition]:
+    """load_catalog(path), with the images decoded and keep-out areas checked by a child process.
+
+    Every check still runs before the app serves anything, and a bad floorplan still stops it with
+    the same ConfigError; but Pillow and shapely (7 MB of a server's idle RSS, issue 32) are loaded
+    by the child, and by the server only when a page first asks for an image or a goal meets a
+    keep-out area. The result is kept per process while the files are unchanged (the tests make
+    many apps on the same floorplans)."""
+    path = Path(path)
+    key = str(path.resolve()) if path.is_file() else str(path)
+    with _checked_apart_lock:
+        kept = _checked_apart.get(key)
+        if kept is None or kept[0] != _stats([key, *kept[1]]):
+            sizes = _check_in_child(path)
+            kept = _checked_apart[key] = (_stats([key, *sizes]), sizes)
+    token = _CHECKED_SIZES.set(kept[1])
+    try:
+        return load_catalog(path)
+    finally:
+        _CHECKED_SIZES.reset(token)
+
+
+def _stats(paths: list[str]) -> list:
+    out = []
+    for p in paths:
+        try:
+            st = Path(p).stat()
+            out.append((p, st.st_mtime_ns, st.st_size))
+        except OSError:
+            out.append((p, None, None))
+    return out
+
+
+def _check_in_child(path: Path) -> dict[str, list[int]]:
+    try:
+        done = subprocess.run([sys.executable, "-m", "rover_web.livemap.check_maps", str(path)], capture_output=True,
+                              text=True, timeout=CHECK_TIMEOUT_S, check=False)
+        answer = json.loads(done.stdout.strip().splitlines()[-1]) if done.stdout.strip() else {}
+    except (OSError, subprocess.TimeoutExpired, ValueError) as exc:
+        raise ConfigError(f"{path}: the floorplans could not be checked ({exc})") from None
+    if "error" in answer:
+        raise ConfigError(answer["error"])
+    if "sizes" not in answer:
+        raise ConfigError(f"{path}: the floorplans could not be checked: {done.stderr.strip()[-500:]}")
+    return answer["sizes"]
 
 
 def first_waypoint_or_centre(definition: MapDefinition) -> tuple[float, float, float]:

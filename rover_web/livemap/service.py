@@ -22,7 +22,7 @@ from rover_web.placement import MAP, TF, MapPlacer, Unplaceable, tf_buffer
 from . import msgs
 from .geometry import MapGeometry, wrap_angle
 from .keep_out import check_goal
-from .map_files import MAX_IMAGE_SIDE_PX, MapDefinition, load_catalog, maps_file_path
+from .map_files import MAX_IMAGE_SIDE_PX, MapDefinition, load_catalog_checked_apart, maps_file_path
 from .occupancy import grid_to_image, image_to_png
 from .state import LiveMap, Pose2D, RobotTrack, UnknownMap, goal_payload, plan_payload, pose_payload
 
@@ -48,7 +48,7 @@ class ShuttingDown(RuntimeError):
 def load_files(config: dict[str, Any]) -> dict[str, MapDefinition]:
     """The floorplans of ROVER_WEB_MAPS_FILE; ConfigError for them or for the default map setting."""
     path = maps_file_path(config["ROVER_WEB_MAPS_FILE"])
-    files = load_catalog(path) if path is not None else {}
+    files = load_catalog_checked_apart(path) if path is not None else {}
     if LIVE_MAP_NAME in files:
         raise ConfigError(f"{path}: {LIVE_MAP_NAME!r}: that name is kept for the live OccupancyGrid map; rename it")
     default = config["ROVER_WEB_LIVEMAP_DEFAULT_MAP"]

@@ -27,6 +27,8 @@ READABLE = {404: "not_found", 409: "recording_in_progress", 422: "not_a_recordin
 TOPIC = query("topic", {"type": "string", "maxLength": 256}, "a topic of the recording", required=True)
 TIME = query("t", {"type": "number", "minimum": 0}, "the time to show, in seconds since the epoch (as the "
              "timeline's start and end)", required=True)
+TF_TIME = query("t", {"type": "number", "minimum": 0}, "the time of the recording (s since the epoch); absent: "
+                "its end")
 NUMBERS = {"type": "array", "items": {"type": ["number", "null"]}}
 
 FRAME = op("The camera frame at a time of the recording, as JPEG (X-Frame-Time: its log time; X-Frame-Error when "
@@ -105,6 +107,36 @@ PATHS = {
                   errors={**READABLE, 400: "bad_time"}),
     },
     "/api/recordings/{recording_id}/frame": {"get": FRAME},
+    # The recording's frames (rover_web/tf/replay.py): what a TF listener held at t, read from the file.
+    "/recordings/{recording_id}/tf": {"get": page("The TF page for a recording: its frames at ?t= (the end by "
+                                                  "default)", tag="pages", params=[TF_TIME],
+                                                  errors={**READABLE, 400: "bad_time"})},
+    "/api/recordings/{recording_id}/tf": {
+        "get": op("The recording's TF tree at a time, in GET /api/tf's shape: static transforms logged up to t, "
+                  "dynamic ones in the cache window before it, from every tf2_msgs/msg/TFMessage topic (a name "
+                  "ending in tf_static is static)", tag="recording", params=[TF_TIME],
+                  ok=obj({"t": {"type": "number"}, "start": {"type": "number"}, "end": {"type": "number"},
+                          "tf_topics": {"type": "object", "additionalProperties": {"type": "boolean"}},
+                          "read": {"type": "object"}, "frames": {"type": "object"}, "roots": {"type": "array"},
+                          "warnings": {"type": "array"}}, closed=False),
+                  errors={**READABLE, 400: "bad_time"}),
+    },
+    "/api/recordings/{recording_id}/tf/lookup": {
+        "get": op("A transform between two of the recording's frames at ?t= (as GET /api/tf/lookup answers live)",
+                  tag="recording",
+                  params=[TF_TIME, query("target", {"type": "string", "minLength": 1, "maxLength": 256},
+                                         "the frame the answer is expressed in", required=True),
+                          query("source", {"type": "string", "minLength": 1, "maxLength": 256},
+                                "the frame whose points are mapped", required=True),
+                          query("time", {"type": "number", "minimum": 0},
+                                "the stamp to look up at (s); absent or 0: the latest common time")],
+                  ok=obj({"target": {"type": "string"}, "source": {"type": "string"},
+                          "translation": {"type": "array"}, "rotation": {"type": "array"}, "yaw": {"type": "number"},
+                          "stamp": {"type": "number"}, "stamp_ns": {"type": "integer"}}),
+                  errors={**READABLE, 400: "bad_time, missing_frame, bad_frame, invalid",
+                          404: "not_found, unknown_frame",
+                          409: "recording_in_progress, not_connected, extrapolation_past, extrapolation_future"}),
+    },
     "/api/recordings/upload": {
         "post": op("Upload an MCAP file from elsewhere to replay it (the body is the file); listed as uploaded",
                    tag="recording", role="operator", status=201, ok=RECORDING,

@@ -4,11 +4,8 @@ As `ros2 bag play` does: each message's CDR bytes go out unchanged (rclpy publis
 serialized message), at its recorded log time relative to the first one, divided by --rate. It
 runs its own rclpy context and node (the CLI never starts the app's), so a team can rehearse with
 real data and no robot. The audit channel (/rover_web/audit) is only replayed when named in --topics:
-it was never a ROS topic.
-
-/tf_static goes out transient local, as tf2's static broadcaster sends it: a TF listener subscribes
-it transient local and would never match a volatile publisher, so a replayed robot's mounts (its
-laser's, its antenna's) reach the server and its scans are placed through them.
+it was never a ROS topic. /tf_static goes out transient local, as tf2's static broadcasters
+publish it (its subscribers match nothing else).
 """
 
 from __future__ import annotations
@@ -21,11 +18,6 @@ from flask import Flask, current_app
 
 NODE_NAME = "rover_web_replay"
 AUDIT_TOPIC = "/rover_web/audit"
-STATIC_TF_DEPTH = 100  # every static broadcaster's message kept for a listener that joins late
-
-
-def _qos(topic: str) -> dict:
-    return {"qos": "latched", "depth": STATIC_TF_DEPTH} if topic.rsplit("/", 1)[-1] == "tf_static" else {}
 
 
 def init_cli(app: Flask) -> None:
@@ -64,6 +56,13 @@ def init_cli(app: Flask) -> None:
             player.close()
 
 
+STATIC_TF_DEPTH = 100
+
+
+def _static_tf(type_name: str, topic: str) -> bool:
+    return type_name == "tf2_msgs/msg/TFMessage" and topic.rstrip("/").endswith("tf_static")
+
+
 class _Player:
     def __init__(self, domain_id: int | None, rate: float, wanted: set[str], delay: float):
         from rover_web.ros.raw import RawPublisherNode
@@ -86,7 +85,13 @@ class _Player:
             self._skipped.add(channel.topic)
             return None
         try:
-            publisher = self.ros.publisher(schema.name, channel.topic, **_qos(channel.topic))
+            if _static_tf(schema.name, channel.topic):
+                # tf2's listeners take /tf_static transient local only: a volatile publisher would
+                # never reach them. Every static message of the file is kept for late joiners, as
+                # each static broadcaster keeps its own.
+                publisher = self.ros.publisher(schema.name, channel.topic, STATIC_TF_DEPTH, latched=True)
+            else:
+                publisher = self.ros.publisher(schema.name, channel.topic)
         except UnknownMessageType as exc:
             click.echo(f"skipping {channel.topic}: {exc}", err=True)
             self._skipped.add(channel.topic)

@@ -173,3 +173,46 @@ def upload_recording():
     response = jsonify(status)
     response.status_code = 201
     return response
+
+
+# --- TF: the recording's frames (rover_web/tf/replay.py) ---
+
+
+def _tf_time(index: FileIndex) -> int:
+    """?t= (seconds since the epoch) as ns; absent: the recording's end."""
+    if request.args.get("t", "") == "":
+        return index.end_ns or 0
+    return int(round(_time() * 1e9))
+
+
+def _tf_tree(recording_id: str) -> tuple[FileIndex, int, dict]:
+    from rover_web.tf.replay import tree_at
+
+    index = _readable(recording_id)
+    config = _service().rover.config
+    t_ns = _tf_time(index)
+    return index, t_ns, tree_at(index, t_ns, config["ROVER_WEB_TF_CACHE_S"], config["ROVER_WEB_TF_STALE_S"])
+
+
+@bp.get("/recordings/<recording_id>/tf")
+def recording_tf_page(recording_id: str):
+    """The TF page for a recording: its frames at ?t= (the end by default), read from the file."""
+    status = _service().status(_id(recording_id))
+    _index, t_ns, tree = _tf_tree(recording_id)
+    return render_template("recording_tf.html", recording=status, tf=tree, tf_replay=True,
+                           tf_lookup_url=f"/api/recordings/{status['id']}/tf/lookup?t={t_ns / 1e9:.9f}")
+
+
+@bp.get("/api/recordings/<recording_id>/tf")
+def recording_tf(recording_id: str):
+    return jsonify(_tf_tree(recording_id)[2])
+
+
+@bp.get("/api/recordings/<recording_id>/tf/lookup")
+def recording_tf_lookup(recording_id: str):
+    from rover_web.tf.replay import cached_buffer_at
+    from rover_web.tf.routes import lookup_response
+
+    index = _readable(recording_id)
+    buffer, _info = cached_buffer_at(index, _tf_time(index), _service().rover.config["ROVER_WEB_TF_CACHE_S"])
+    return lookup_response(buffer)

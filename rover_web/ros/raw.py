@@ -27,17 +27,18 @@ class RawPublisherNode:
         self.node = rclpy.create_node(node_name, context=self.context, start_parameter_services=False)
         self._publishers: list = []
 
-    def publisher(self, type_name: str, topic: str, depth: int = 10, qos: str | None = None):
+    def publisher(self, type_name: str, topic: str, depth: int = 10, *, latched: bool = False):
         """A publisher whose publish(bytes) sends them as the serialized message; UnknownMessageType
-        when the type's Python package is not installed. `qos`: a named profile (ros/qos.py) instead."""
-        from . import qos as profiles
+        when the type's Python package is not installed. `latched`: transient local, keeping the
+        last `depth` messages for late joiners (what /tf_static's subscribers ask for: they match
+        no volatile publisher)."""
+        qos = depth
+        if latched:
+            from .qos import profile
 
-        if qos is None:
-            profile = depth
-        else:
-            profile = profiles.profile(qos, depth)
-            profile.depth = depth  # the named profiles fix their own depth ("latched" keeps 1)
-        publisher = self.node.create_publisher(message_class(type_name), topic, profile)
+            qos = profile("latched")
+            qos.depth = depth
+        publisher = self.node.create_publisher(message_class(type_name), topic, qos)
         self._publishers.append(publisher)
         return publisher
 

@@ -18,7 +18,7 @@ from . import routes
 from .buffer import TfBuffer, TfError, Transform
 from .service import CHANNEL, TICK_S, TfService
 
-__all__ = ["TfBuffer", "TfError", "TfService", "Transform", "init_app"]
+__all__ = ["TfBuffer", "TfError", "TfService", "Transform", "add_nav", "init_app"]
 
 
 def init_app(app, fleet: Fleet) -> None:
@@ -30,17 +30,24 @@ def init_app(app, fleet: Fleet) -> None:
     app.register_blueprint(routes.bp)
 
 
+def add_nav(fleet: Fleet) -> None:
+    """The TF page's link, among the pages that observe the robot (init_app runs early, before them)."""
+    for rover in fleet:
+        rover.add_nav("TF", "/tf")
+
+
 def _init_robot(rover: Rover, msgs, missing: str | None) -> None:
     service = TfService(rover, missing=missing, clock_ns=msgs.clock_ns(rover.runtime),
                          publishers=msgs.publishers(rover.runtime))
     rover.add_feature(service)
     rover.hub.register(CHANNEL)
-    rover.add_nav("TF", "/tf")
     if missing is not None:
         return
     runtime = rover.runtime
     for kind, qos in (("dynamic", msgs.DYNAMIC_QOS), ("static", msgs.STATIC_QOS)):
         static = kind == "static"
+        # /tf's age in /api/status says whether the robot's frames move; /tf_static is sent once
+        # per broadcaster, and would only ever read as stale there.
         runtime.subscribe(msgs.TF_MESSAGE, service.topics[kind], lambda raw, s=static: service.on_raw(raw, s),
-                          qos, raw=True, share=True)
+                          qos, raw=True, share=True, track=not static)
     rover.every(TICK_S, service.publish, name="tf-tree")

@@ -24,7 +24,7 @@ def missing() -> str | None:
     """None when tf2_msgs/msg/TFMessage can be subscribed; otherwise what is missing and how to get it."""
     try:
         message_class(TF_MESSAGE)
-    except UnknownMessageType as exc:
+    except (UnknownMessageType, ImportError) as exc:
         return f"{TF_MESSAGE} is not available ({exc}): {HOW_TO_GET}"
     return None
 

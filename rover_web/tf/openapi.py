@@ -17,7 +17,8 @@ TREE = obj({
                                                                   "unnormalised", "several_trees"]},
                                                 "message": {"type": "string"}}, ("kind", "message"), closed=False)},
     "rejected": {"type": "array", "description": "transforms tf2 would ignore, counted by reason (nan, "
-                                                "unnormalised, self_transform, no_frame_id, old_data, repeated)"},
+                                                "unnormalised, self_transform, no_frame_id, old_data, repeated, "
+                                                "too_many_frames)"},
     "now": {"type": "number", "description": "the clock ages are measured against (s)"},
     "cache_s": {"type": "number"},
 }, closed=False)

@@ -26,7 +26,7 @@ def api_tf():
     return jsonify(current_feature(TfService).tree())
 
 
-def _frame_arg(name: str) -> str:
+def frame_arg(name: str) -> str:
     value = request.args.get(name, "")
     if not value:
         raise ApiError(400, "missing_frame", f"{name} is required: a frame id such as map or base_link")
@@ -35,7 +35,7 @@ def _frame_arg(name: str) -> str:
     return value
 
 
-def _time_arg() -> int | None:
+def time_arg() -> int | None:
     raw = request.args.get("time", "")
     if raw == "":
         return None
@@ -53,19 +53,24 @@ def transform_json(tf, target: str, source: str) -> dict:
             "rotation": list(tf.rotation), "yaw": tf.yaw, "stamp": tf.stamp_ns / 1e9, "stamp_ns": tf.stamp_ns}
 
 
-@bp.get("/api/tf/lookup")
-def api_tf_lookup():
-    target, source, stamp = _frame_arg("target"), _frame_arg("source"), _time_arg()
-    service = current_feature(TfService)
+def lookup_response(buffer, missing: str | None = None):
+    """The answer to ?target=&source=&time= from `buffer`: the transform, or tf2's reason as a 4xx."""
+    target, source, stamp = frame_arg("target"), frame_arg("source"), time_arg()
     try:
-        tf = service.buffer.lookup(target, source, stamp)
+        tf = buffer.lookup(target, source, stamp)
     except TfError as exc:
-        if not service.available and exc.kind == "unknown_frame":
-            raise ApiError(503, "tf_unavailable", service.missing) from None
+        if missing and exc.kind == "unknown_frame":
+            raise ApiError(503, "tf_unavailable", missing) from None
         response = jsonify(error=exc.kind, message=exc.message, detail=exc.detail)
         response.status_code = STATUS.get(exc.kind, 400)
         return response
     return jsonify(transform_json(tf, target, source))
+
+
+@bp.get("/api/tf/lookup")
+def api_tf_lookup():
+    service = current_feature(TfService)
+    return lookup_response(service.buffer, service.missing)
 
 
 @bp.get("/tf")

@@ -47,6 +47,7 @@ function show() {
   slider.value = span() > 0 ? Math.round((now / span()) * Number(slider.max)) : 0;
   $('replay-time').textContent = `${clock(t)} (+${now.toFixed(1)} s of ${span().toFixed(1)} s)`;
   $('replay').dataset.t = String(t);
+  $('replay-tf').search = `?t=${t.toFixed(3)}`;  // the frames at the slider's time (rover_web/tf/replay.py)
   fillList($('replay-audit'), data.audit, t, (r) => `${r.by || '?'}: ${r.detail || r.action}`);
   fillList($('replay-logs'), data.logs, t, (l) => `[${l.level}] ${l.name}: ${l.msg}`);
   for (const part of parts) part.show(t);

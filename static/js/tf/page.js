@@ -32,7 +32,8 @@ $('tf-lookup').addEventListener('submit', async (event) => {
   const query = new URLSearchParams({ target: $('tf-target').value.trim(), source: $('tf-source').value.trim() });
   if ($('tf-time').value) query.set('time', $('tf-time').value);
   try {
-    const tf = await api('GET', `${card.dataset.lookup}?${query}`);
+    const joiner = card.dataset.lookup.includes('?') ? '&' : '?';  // the replay's URL already holds ?t=
+    const tf = await api('GET', `${card.dataset.lookup}${joiner}${query}`);
     const [x, y, z] = tf.translation;
     const [qx, qy, qz, qw] = tf.rotation;
     out.dataset.error = 'false';
