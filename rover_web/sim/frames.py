@@ -6,7 +6,7 @@ pose, and an operator's initial pose moves the robot on the map by changing `map
 AMCL does), not by making odometry jump. Both go out with every odometry message, at its rate and
 stamp. The sensors' mounts go out once on /tf_static (transient local, as robot_state_publisher
 sends them): a laser mounted upside down (roll 180 degrees), turned and off the robot's centre, a
-GPS antenna behind and above it, and a camera pitched down. The laser's scan is ray-cast from that
+GPS antenna above it, and a camera pitched down. The laser's scan is ray-cast from that
 mount (perception.py), so it lands on the walls only when it is placed through TF: the configured
 offset (0, 0, 0 by default) would draw it mirrored.
 
@@ -50,7 +50,9 @@ class Mount:
 
 
 LASER = Mount(LASER_FRAME, 0.15, -0.08, 0.25, roll=math.pi, yaw=0.5)
-GPS = Mount(GPS_FRAME, -0.10, 0.05, 0.60)
+# The antenna straight above the centre: the simulated /fix is the robot's map pose, so a mount off
+# centre would make the GPS map (which takes it out through TF) draw the robot off its fix.
+GPS = Mount(GPS_FRAME, 0.0, 0.0, 0.60)
 CAMERA = Mount(CAMERA_FRAME, 0.20, 0.0, 0.35, pitch=0.3)
 MOUNTS = (LASER, GPS, CAMERA)
 
