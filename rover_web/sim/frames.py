@@ -1,9 +1,8 @@
 """The simulated rover's frames, published as a real robot's are: /tf and /tf_static (REP 105).
 
-`odom` -> `base_link` is its odometry (smooth, never jumps) and `map` -> `odom` its own
-localisation's correction: odometry starts where the robot boots, so `map` -> `odom` is the start
-pose, and an operator's initial pose moves the robot on the map by changing `map` -> `odom` (as
-AMCL does), not by making odometry jump. Both go out with every odometry message, at its rate and
+`odom` -> `base_link` is its odometry and `map` -> `odom` its own localisation's correction: an
+operator's initial pose moves the robot on the map by changing `map` -> `odom` (as AMCL does), not
+by making odometry's position jump. Both go out with every odometry message, at its rate and
 stamp. The sensors' mounts go out once on /tf_static (transient local, as robot_state_publisher
 sends them): a laser mounted upside down (roll 180 degrees), turned and off the robot's centre, a
 GPS antenna above it, and a camera pitched down. The laser's scan is ray-cast from that
@@ -83,8 +82,10 @@ def beam_directions(angles: np.ndarray, mount: Mount = LASER) -> np.ndarray:
 class Localisation:
     """map -> odom of a robot whose map pose is its truth (the simulator has no drift).
 
-    Odometry is the map pose seen from where the robot booted; a relocalisation (initial pose)
-    changes map -> odom so odometry stays continuous."""
+    Odometry is the map pose seen from where odometry started; a relocalisation (initial pose)
+    moves map -> odom so odometry's position stays continuous. Its heading is kept (odom stays
+    aligned with the map, east in the demo), and the turn goes into odometry's yaw as a compass-aided
+    base's would: the GPS map reads the heading from /odom."""
 
     def __init__(self, start: Pose2D):
         self.map_t_odom: Pose2D = start
@@ -93,8 +94,11 @@ class Localisation:
         return compose(invert(self.map_t_odom), map_pose)
 
     def relocalise(self, old_map_pose: Pose2D, new_map_pose: Pose2D) -> None:
-        """The robot is told it is at new_map_pose while its odometry still reads old's."""
-        self.map_t_odom = compose(new_map_pose, invert(self.odom_pose(old_map_pose)))
+        """The robot is told it is at new_map_pose while its odometry still reads old's position."""
+        ox, oy, _ = self.odom_pose(old_map_pose)
+        yaw = self.map_t_odom[2]
+        c, s = math.cos(yaw), math.sin(yaw)
+        self.map_t_odom = (new_map_pose[0] - (c * ox - s * oy), new_map_pose[1] - (s * ox + c * oy), yaw)
 
 
 class FramePublisher:

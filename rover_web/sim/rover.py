@@ -9,8 +9,8 @@ map pose laid on a local tangent plane around a configurable origin (by default 
 Benderson Park, Sarasota, FL, where RobotX is held).
 
 It starts on the first floorplan of map_files/all_maps.json (at that map's first waypoint), jumps
-to an initial pose on /initialpose (as AMCL would re-localise: map -> odom moves, odometry stays
-continuous; it has no odometry drift), and
+to an initial pose on /initialpose (as AMCL would re-localise: map -> odom moves, odometry's
+position stays continuous; it has no odometry drift), and
 drives itself to a goal received on /goal_pose (frame `map`) with a simple turn-and-drive
 controller, publishing a straight-line /plan while it goes, and stops there. The operator always
 wins: any /cmd_vel message, a stop included, cancels the goal, as a stop button would on a
@@ -193,7 +193,7 @@ class RoverSim(Node):
         self.fix_pub = self.create_publisher(NavSatFix, "fix", 10)
         self.plan_pub = self.create_publisher(Path, "plan", 1)
         # Odometry starts in the map's coordinates (map -> odom the identity, as a datum would set
-        # it); an initial pose then moves map -> odom and odometry stays continuous (frames.py).
+        # it); an initial pose then moves map -> odom and odometry's position stays continuous (frames.py).
         self.localisation = Localisation((0.0, 0.0, 0.0))
         self.frames = FramePublisher(self, self.localisation)
         self.last_stamp = self.get_clock().now().to_msg()  # of the latest odometry: the pose sensors use
