@@ -8,6 +8,7 @@ import pytest
 import requests
 
 from rover_web.overlays.costmap import decode
+from rover_web.sim.frames import LASER, laser_origin
 from tests.support.waiting import wait_until
 
 pytestmark = pytest.mark.ros
@@ -256,3 +257,31 @@ def test_a_local_costmap_and_footprint_in_odom_are_placed_with_amcl_s_map_to_odo
               "polygon": {"points": [{"x": 1.0, "y": 0.0}, {"x": 2.0, "y": 0.0}, {"x": 2.0, "y": 1.0}]}}
     foot = publish_until(posed, "/global_costmap/published_footprint", square, stream, "footprint")
     assert foot["polygon"] == [[10.0, 10.0], [10.0, 11.0], [9.0, 11.0]]
+
+
+def test_after_an_initial_pose_the_simulator_s_map_to_odom_moves_and_its_scan_still_lies_on_the_walls(
+        live_server, sim_process, ros_peer, sse_client):
+    """The simulator relocalises as AMCL does (map -> odom moves, odometry's position does not jump):
+    the scan, placed through map -> odom -> base_link -> base_scan, is on the walls at the new pose."""
+    sim_process("--only", "rover")
+    stream = sse_client(live_server.url + "/api/events?channels=scan")
+    stream.wait_for("scan", lambda d: d["placed_by"] == "tf", timeout=30)
+    peer = ros_peer("initial_pose_peer")
+    peer.advertise("/initialpose", AMCL)
+    peer.wait_match("/initialpose")
+    x, y, yaw = 18.0, 10.5, 2.5   # the middle of the basement's corridor, facing west-north-west
+    pose = {**amcl(x, y, yaw), "header": {"frame_id": "map"}}
+
+    def moved():
+        peer.publish("/initialpose", pose)
+        odom = requests.get(live_server.url + "/api/tf/lookup", params={"target": "map", "source": "odom"},
+                            timeout=5)
+        return odom.ok and abs(odom.json()["translation"][0]) > 1.0 and odom.json()
+    map_odom = wait_until(moved, timeout=15, interval=0.5, what="map -> odom moved by the initial pose")
+    assert map_odom["yaw"] == pytest.approx(0.0, abs=1e-9)   # a position correction; odom stays map-aligned
+    lx, ly, heading = laser_origin((x, y, yaw))
+    scan = stream.wait_for("scan", lambda d: d["points"] and abs(d["pose"][0] - lx) < 0.01, timeout=15)["json"]
+    assert scan["pose"][:2] == pytest.approx([lx, ly], abs=0.01) and scan["placed_by"] == "tf"
+    assert math.cos(scan["pose"][2] - heading) == pytest.approx(1.0, abs=1e-4)
+    assert LASER.frame == scan["frame_id"]
+    assert on_walls(np.array(scan["points"]).reshape(-1, 2)) == 1.0
