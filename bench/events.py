@@ -20,11 +20,13 @@ import sys
 import time
 
 from common import ROOT, Server, SseFleet, free_port, machine, percentile, ros_env, stop_process, summary_ms
+from metrics import Scraper
 
 
-def run(clients: int, seconds: float, env: dict) -> dict:
+def run(clients: int, seconds: float, env: dict, scrape_s: float = 0) -> dict:
     server = Server(env)
     fleet = SseFleet(server.url, "/api/events?channels=odom", clients)
+    scraper = Scraper(server.url, scrape_s) if scrape_s else None
     try:
         fleet.poll(0.5, lambda *a: None)  # snapshots
         count = int(seconds * 100)
@@ -46,6 +48,8 @@ def run(clients: int, seconds: float, env: dict) -> dict:
         return {"clients": clients, "arrived": arrived, "woken": woken, "expected": count * clients,
                 "cpu_pct": 100 * (cpu1 - cpu0) / (t1 - t0), "rss_mb": server.rss_mb()}
     finally:
+        if scraper:
+            print(f"  ({scraper.stop()})", flush=True)
         fleet.close()
         server.stop()
 
@@ -113,6 +117,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--seconds", type=float, default=10.0)
     parser.add_argument("--clients", type=int, nargs="*", default=[1, 10, 50])
+    parser.add_argument("--scrape-metrics", type=float, default=0, metavar="S",
+                        help="meanwhile, GET /metrics every S seconds, as Prometheus would (issue 42)")
     parser.add_argument("--floor", action="store_true",
                         help="also the plain-socket writer (bench/sse_floor.py), the same clients, right after")
     args = parser.parse_args()
@@ -126,7 +132,7 @@ def main() -> None:
         ros = run_rclpy(args.seconds, env)
         print(f"rclpy -> rclpy: median {ros['median_ms']:.3f} ms  p99 {ros['p99_ms']:.3f} ms  n={ros['n']}", flush=True)
     for n in args.clients:
-        r = run(n, args.seconds, env)
+        r = run(n, args.seconds, env, args.scrape_metrics)
         report("clients", r)
         if args.floor:
             f = run_floor(n, args.seconds)

@@ -17,7 +17,9 @@ Reported: the hub's CPU (% of one core) over the measured window, with every rob
 the summaries' age on the hub (`summary_age_s` of GET /api/robots, sampled every 0.5 s for every
 robot: how old what an operator sees is; a 1 Hz robot's is 0-1 s by design) p50/p99/max; then
 `--stops` rounds of POST /api/estop/all: the HTTP round trip, the hub's own `took_s` (first
-command sent to last answer in), and how many robots answered engaged.
+command sent to last answer in), and how many robots answered engaged. Issue 42: the cost of one
+GET /metrics with every robot heard (server CPU per scrape, bench/metrics.py's way; its size and
+series; target <= 20 ms at 100 robots) and the size of the /robots page. One JSON line last.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ import time
 
 import requests
 from common import ROOT, Server, free_port, machine, percentile, ros_env, stop_process
+from metrics import scrape_cost
 
 FLEET = "bench"
 
@@ -117,6 +120,7 @@ def main() -> None:
     parser.add_argument("--processes", type=int, default=2)
     parser.add_argument("--seconds", type=float, default=20.0)
     parser.add_argument("--stops", type=int, default=3)
+    parser.add_argument("--scrapes", type=int, default=100, help="GET /metrics back to back, for its cost")
     parser.add_argument("--router", action="store_true", help="through a Zenoh router process (clients of it)")
     parser.add_argument("--router-child", metavar="ENDPOINT", help=argparse.SUPPRESS)
     parser.add_argument("--child", nargs=3, metavar=("ENDPOINT", "KEY_FILE", "NAMES"), help=argparse.SUPPRESS)
@@ -130,7 +134,7 @@ def main() -> None:
 
     tmp = tempfile.TemporaryDirectory(prefix="rover_web-bench-hub-")
     key_file = os.path.join(tmp.name, "fleet.key")
-    with open(key_file, "w") as fh:
+    with open(os.open(key_file, os.O_WRONLY | os.O_CREAT, 0o600), "w") as fh:  # the hub refuses a looser key
         fh.write(os.urandom(32).hex())
     endpoint = f"tcp/127.0.0.1:{free_port()}"
     zrouter = None
@@ -185,6 +189,15 @@ def main() -> None:
         print(f"summary age on the hub: p50 {percentile(ages, 50):.3f} s, p99 {percentile(ages, 99):.3f} s, "
               f"max {max(ages):.3f} s over {len(ages)} samples; lost samples: {lost}")
 
+        scrape = scrape_cost(hub, args.scrapes, 3.0)
+        print(f"hub /metrics at {args.robots} robots: {scrape['cpu_ms_per_scrape']:.2f} ms server CPU per scrape "
+              f"(target <= 20), wall p50 {scrape['wall_p50_ms']:.2f} ms p99 {scrape['wall_p99_ms']:.2f} ms, "
+              f"{scrape['bytes']} bytes, {scrape['series']} series")
+        t = time.monotonic()
+        page = requests.get(hub.url + "/robots", timeout=10)
+        print(f"hub /robots page at {args.robots} robots: {len(page.content)} bytes in "
+              f"{(time.monotonic() - t) * 1000:.0f} ms")
+        stops = []
         for i in range(args.stops):
             t = time.monotonic()
             answer = requests.post(hub.url + "/api/estop/all", json={}, timeout=60).json()
@@ -192,7 +205,11 @@ def main() -> None:
             engaged = sum(a["result"] == "engaged" for a in answer["robots"].values())
             print(f"stop-all {i + 1}: HTTP {http_s * 1000:.0f} ms, hub took_s {answer['took_s'] * 1000:.0f} ms, "
                   f"{engaged}/{args.robots} answered engaged")
+            stops.append(answer["took_s"])
             time.sleep(1.0)
+        print(json.dumps({"bench": "hub", "robots": args.robots, "hub_cpu_pct": round(cpu, 1),
+                          "summary_age_p99_s": round(percentile(ages, 99), 3), "scrape": scrape,
+                          "page_bytes": len(page.content), "stop_all_took_s": stops}))
     finally:
         for proc in children:
             try:

@@ -42,6 +42,7 @@ from common import (
     summary_ms,
     wait_for_topic,
 )
+from metrics import Scraper
 
 MAX_LINEAR = 5.0
 RATE_HZ = 40.0
@@ -378,6 +379,8 @@ def main() -> None:
     parser.add_argument("--overlays", type=int, default=0, metavar="VIEWERS",
                         help="meanwhile, LiveMap's overlay load (bench/overlay_publisher.py: a 1,080-beam scan at "
                              "20 Hz and a 400x400 costmap at 1 Hz) to this many SSE viewers (issue 30)")
+    parser.add_argument("--scrape-metrics", type=float, default=0, metavar="S",
+                        help="meanwhile, GET /metrics every S seconds, as Prometheus would (issue 42)")
     parser.add_argument("--recording", action="store_true",
                         help="meanwhile, a recording of bench/recording.py's 20 topics with the camera (issue 28)")
     args = parser.parse_args()
@@ -389,8 +392,10 @@ def main() -> None:
     print(f"# teleop bench on {machine()}: app in its own process, subscriber in another "
           f"(ROS domain {env['ROS_DOMAIN_ID']})", flush=True)
     server = Server(env)
-    sub = baseline = load = None
+    sub = baseline = load = scraper = None
     try:
+        if args.scrape_metrics:
+            scraper = Scraper(server.url, args.scrape_metrics)
         if args.overlays:
             load = OverlayLoad(server.url, env, args.overlays)
         elif args.recording:
@@ -408,6 +413,8 @@ def main() -> None:
         bench_close(server, sub, args.trials)
         bench_rate(server, sub, args.hold_s)
     finally:
+        if scraper:
+            print(scraper.stop(), flush=True)
         if load:
             load.stop()
         if baseline:

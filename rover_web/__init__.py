@@ -77,6 +77,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         layouts,
         livemap,
         logs,
+        metrics,
         overlays,
         panels,
         plot,
@@ -87,6 +88,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         teleop,
         tf,
         topics,
+        view3d,
         waypoints,
     )
     from rover_web import fleet as fleet_pages
@@ -123,6 +125,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         panels.init_app(app, fleet)
         livemap.init_app(app, fleet)
         overlays.init_app(app, fleet)  # what the robot senses, on LiveMap
+        view3d.init_app(app, fleet)  # after overlays (it shares their markers subscription) and tf
         camera.init_app(app, fleet)
         topics.init_app(app, graph)
         logs.init_app(app, graph)
@@ -134,6 +137,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         recording.init_app(app, fleet)  # last of the features: it records what they publish and do
         fleet_pages.init_app(app, fleet)  # /robots, /api/robots and /robots/<name>/... for every route
         zenoh_link.init_app(fleet)  # last: its summaries read every feature; its stop engages the e-stop
+        metrics.init_app(app, fleet)  # GET /metrics reads every feature at scrape time
     except BaseException:
         # A feature that failed to start may follow others that already started loops and
         # threads: stop them all in order, not just the node under them.

@@ -67,10 +67,18 @@ SETTINGS: tuple[Setting, ...] = (
             "serve as a fleet hub: no ROS node, every robot heard over Zenoh on /robots, stop-all to each"),
     Setting("FLEET_LOST_AFTER_S", 3.0, "float",
             "the hub shows a robot lost when no summary came for this long (or its liveliness token went)", 1.5, 60),
+    Setting("FLEET_FORGET_AFTER_S", 3600.0, "float",
+            "the hub drops a robot from its list once it has been lost this long (it stays in the history)",
+            10, 30 * 86400),
+    Setting("HUB_HISTORY_DAYS", 30.0, "float", "how long the hub keeps each robot's history", 0.01, 3650),
+    Setting("HUB_HISTORY_MAX_ROWS", 10000, "int", "the most history rows the hub keeps per robot", 10, 10_000_000),
     Setting("FLEET_STOP_TIMEOUT_S", 2.0, "float",
             "how long the hub's stop-all waits for each robot's answer (no_answer after)", 0.1, 30),
     Setting("FLEET_COMMAND_WINDOW_S", 10.0, "float",
             "a robot refuses a signed stop whose timestamp is further than this from its clock", 1, 300),
+    Setting("METRICS", "on", "str",
+            "GET /metrics in the Prometheus text format: on (open on loopback as the API is; a viewer's token "
+            "when exposed) or off (404)", choices=("on", "off")),
     # --- sign-in and HTTPS ---
     Setting("AUTH", "auto", "str",
             "sign-in: auto (required unless the server listens on loopback only), required, or off",
@@ -247,6 +255,14 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("FOOTPRINT_TOPIC", "/global_costmap/published_footprint", "optional_topic",
             "geometry_msgs/PolygonStamped footprint drawn on LiveMap; empty: off"),
     Setting("LIVEMAP_TRAIL_S", 60.0, "float", "how far back LiveMap's recent path reaches (s)", 1, 3600),
+    # --- the 3D view (docs/view3d.md) ---
+    Setting("ROBOT_DESCRIPTION_TOPIC", "/robot_description", "optional_topic",
+            "std_msgs/String URDF, transient local, as robot_state_publisher serves it; empty: only URDF_FILE"),
+    Setting("URDF_FILE", None, "optional_str", "a URDF file drawn instead of the description topic's"),
+    Setting("POINTCLOUD_TOPIC", "", "optional_topic",
+            "sensor_msgs/PointCloud2 drawn in the 3D view, thinned on a voxel grid; empty: off"),
+    Setting("POINTCLOUD_MAX_POINTS", 20000, "int", "points a cloud is thinned to for the browser", 100, 200_000),
+    Setting("VIEW3D_POSE_HZ", 10.0, "float", "how often the TF frames' poses go to 3D viewers", 1, 30),
     # --- camera ---
     Setting("CAMERA_TOPIC", "/camera/image_raw", "topic",
             "image topic (sensor_msgs/Image or CompressedImage) the dashboard's camera panel shows first"),

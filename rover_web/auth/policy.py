@@ -10,6 +10,8 @@ Roles, each including the ones below it:
             and /ros's writes: other nodes' parameters, service calls, action goals (root over the
             ROS graph; docs/ros_admin.md#who-may-write).
 The default is closed: a state-changing route nobody listed needs the operator role.
+GET /metrics (Prometheus, a viewer's token as its bearer credentials) and the hub's
+GET /api/robots/<name>/history are reads like any other: the viewer role.
 """
 
 from __future__ import annotations

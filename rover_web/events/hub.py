@@ -46,6 +46,7 @@ class EventHub:
         self._last_change: tuple[int, str, bytes] = (0, "", b"")
         self._channels: set[str] = set()
         self._clients = 0
+        self._watching: dict[str, int] = {}  # channel -> open subscriptions that asked for it
         self._max_clients = max_clients
         self._closed = False
         self._throttle: dict[str, list] = {}  # channel -> [last publish time, held value or None]
@@ -191,11 +192,21 @@ class EventHub:
             if self._clients >= self._max_clients:
                 raise TooManyClients(f"{self._clients} event streams are open already")
             self._clients += 1
-        return Subscription(self, frozenset(channels), last_event_id)
+            channels = frozenset(channels)
+            for channel in channels:
+                self._watching[channel] = self._watching.get(channel, 0) + 1
+        return Subscription(self, channels, last_event_id)
 
-    def _release(self) -> None:
+    def watchers(self, channel: str) -> int:
+        """How many open streams asked for `channel`: a producer whose work only a watcher needs
+        (the overlays' markers and scan) skips it at zero."""
+        return self._watching.get(channel, 0)
+
+    def _release(self, channels: frozenset[str] = frozenset()) -> None:
         with self._cond:
             self._clients -= 1
+            for channel in channels:
+                self._watching[channel] = self._watching.get(channel, 1) - 1
 
 
 class Subscription:
@@ -258,7 +269,7 @@ class Subscription:
     def close(self) -> None:
         if self._open:
             self._open = False
-            self._hub._release()
+            self._hub._release(self.channels)
 
     def __enter__(self) -> Subscription:
         return self

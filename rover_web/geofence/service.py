@@ -9,7 +9,7 @@ import time
 from rover_web.estop import EStopService
 from rover_web.panels.oplog import OperatorLog
 
-from .rules import Fence, parse_fence
+from .rules import Fence, OutsideGeofence, parse_fence
 from .store import GeofenceStore
 
 log = logging.getLogger(__name__)
@@ -38,6 +38,7 @@ class GeofenceService:
         # the geofence loop, never on the executor thread.
         self.pending = threading.Event()
         self._position: tuple[float, float] | None = None
+        self.refused = 0  # goals and routes refused for leaving the fence
         self._state = {"state": "unknown", "lng": None, "lat": None, "since": None, "message": None}
 
     # --- the fence ---
@@ -70,10 +71,18 @@ class GeofenceService:
     # --- checks other features make before anything is stored or published ---
 
     def check_point(self, lng: float, lat: float) -> None:
-        self.fence.check_point(lng, lat)
+        try:
+            self.fence.check_point(lng, lat)
+        except OutsideGeofence:
+            self.refused += 1  # for /metrics (rover_web/metrics)
+            raise
 
     def check_route(self, points) -> None:
-        self.fence.check_route(points)
+        try:
+            self.fence.check_route(points)
+        except OutsideGeofence:
+            self.refused += 1
+            raise
 
     # --- the robot's position ---
 

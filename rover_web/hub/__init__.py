@@ -4,7 +4,9 @@
                         and the last stop-all's answers
   GET  /api/robots      every robot's summary (GET /api/robots's shape on a robot) and how it is heard
   POST /api/estop/all   a signed stop to every robot heard; each robot's answer, or no_answer
-  GET  /api/status      the hub's own state: fleet, robots heard, dropped forged summaries
+  GET  /api/status      the hub's own state: fleet, robots in each state, dropped summaries
+  GET  /api/robots/<name>/history  a robot's state changes, e-stops and stop-all answers, newest first
+  GET  /metrics         each robot's state for Prometheus (rover_web/metrics, hub/metrics.py)
   GET  /api/openapi.json  these routes described
   GET  /tiles/<z>/<x>/<y>  the installed basemap's tiles, for the page's map (rover_web/basemap)
   GET  /basemap/<name>   a drawn (GeoJSON) basemap, for the same map
@@ -12,7 +14,7 @@ Sign-in, users, tokens and roles are rover_web/auth's, as on a robot, in the hub
 
 The hub is no ROS node: create() is called before rover_web imports rclpy, and nothing here
 imports it (tests/integration/hub checks the hub process). Modules: directory (what is heard),
-stop_all, routes; the robots' side is rover_web/zenoh_link.
+history (SQLite), stop_all, metrics, routes; the robots' side is rover_web/zenoh_link.
 """
 
 from __future__ import annotations
@@ -32,9 +34,13 @@ from rover_web.events.hub import EventHub
 from rover_web.zenoh_link.session import link_settings, open_session
 
 from .directory import Directory
+from .history import History
+from .metrics import StopAnswers
 from .stop_all import StopAll
 
 log = logging.getLogger(__name__)
+
+SWEEP_S = 0.25  # how soon a state change reaches the history (the page computes its own at each poll)
 
 __all__ = ["create", "FleetHub"]
 
@@ -45,10 +51,33 @@ class FleetHub:
     It stands where a robot's app keeps its ROS runtime (Rover.runtime): the app's ordered
     shutdown ends with runtime.stop(), which here closes the Zenoh session."""
 
-    def __init__(self, session, directory: Directory, stop_all: StopAll, fleet: str):
+    def __init__(self, session, directory: Directory, stop_all: StopAll, fleet: str, history: History | None = None):
         self.session, self.directory, self.stop_all, self.fleet = session, directory, stop_all, fleet
+        self.history = history
+        self.stop_answers = StopAnswers()  # for /metrics
         self._closed = False
         self._lock = threading.Lock()
+
+    def sweep(self) -> None:
+        """The background loop: each robot's state brought up to date, the changes written down."""
+        events = self.directory.sweep()
+        if self.history is not None and events:
+            try:
+                self.history.record(events)
+            except Exception:  # a full disk must not stop the hub from showing and stopping robots
+                log.exception("hub: could not write %d history events", len(events))
+
+    def stop_robots(self, by: str) -> dict:
+        result = self.stop_all.stop(self.directory.names(), by)
+        self.stop_answers.add(result)
+        if self.history is not None:
+            try:
+                self.history.record([(name, "stop_all", {"by": by, **{k: v for k, v in answer.items()
+                                                                       if k in ("result", "reason")}})
+                                     for name, answer in result["robots"].items()])
+            except Exception:
+                log.exception("hub: could not write the stop-all in the history")
+        return result
 
     def stop(self, timeout_s: float = 0.0) -> None:
         with self._lock:
@@ -64,7 +93,7 @@ class FleetHub:
 
 def create(app: Flask, settings: dict, testing: bool) -> Flask:
     """Finish `app` as a hub: sign-in, the Zenoh session, the routes. ConfigError if it cannot serve."""
-    from rover_web import auth, basemap
+    from rover_web import auth, basemap, metrics
     from rover_web.storage.claim import claim
     from rover_web.storage.db import Database, database_path
 
@@ -90,9 +119,13 @@ def create(app: Flask, settings: dict, testing: bool) -> Flask:
         except Exception as exc:
             raise ConfigError(f"ROVER_WEB_ZENOH_LISTEN/_CONNECT: the hub cannot open its Zenoh session: {exc}") \
                 from None
-        directory = Directory(link.key, link.fleet, settings["ROVER_WEB_FLEET_LOST_AFTER_S"])
+        directory = Directory(link.key, link.fleet, settings["ROVER_WEB_FLEET_LOST_AFTER_S"],
+                              window_s=settings["ROVER_WEB_FLEET_COMMAND_WINDOW_S"],
+                              forget_after_s=settings["ROVER_WEB_FLEET_FORGET_AFTER_S"])
+        history = History(db, settings["ROVER_WEB_HUB_HISTORY_DAYS"] * 86400,
+                          settings["ROVER_WEB_HUB_HISTORY_MAX_ROWS"])
         hub = FleetHub(session, directory, StopAll(session, link.key, link.fleet,
-                                                   settings["ROVER_WEB_FLEET_STOP_TIMEOUT_S"]), link.fleet)
+                                                   settings["ROVER_WEB_FLEET_STOP_TIMEOUT_S"]), link.fleet, history)
         events = EventHub(max_clients=settings["ROVER_WEB_SSE_MAX_CLIENTS"])
         broadcaster = Broadcaster(events, settings["ROVER_WEB_SSE_KEEPALIVE_S"])
         rover = Rover(config, events, hub, None, db=db, broadcaster=broadcaster,
@@ -104,6 +137,7 @@ def create(app: Flask, settings: dict, testing: bool) -> Flask:
         try:
             auth.init_app(app, rover)  # first: every route after it is checked for sign-in and role
             directory.listen(session)
+            rover.every(SWEEP_S, hub.sweep, name="hub-sweep", immediately=True)
         except BaseException:
             rover.shutdown()
             raise
@@ -114,6 +148,7 @@ def create(app: Flask, settings: dict, testing: bool) -> Flask:
             held.release()
         raise
     app.register_blueprint(routes.bp)
+    metrics.init_hub(app, rover, hub)
     basemap.init_app(app, rover)  # the map on /robots draws the same offline basemap as a robot's
     if not testing:
         _stop_with_process(rover)

@@ -9,6 +9,9 @@ from rover_web.basemap.source import map_view
 from rover_web.core.state import current_feature
 from rover_web.web.http import ApiError, json_body
 from rover_web.web.validate import InvalidInput, only_keys, text
+from rover_web.zenoh_link.session import NAME
+
+from .history import PAGE_MAX
 
 bp = Blueprint("hub", __name__)
 
@@ -23,7 +26,9 @@ def _hub():
 
 def _state() -> dict:
     hub = _hub()
-    return {"hub": True, "fleet": hub.fleet, "robots": hub.directory.robots(), "last_stop": hub.stop_all.last}
+    directory = hub.directory
+    return {"hub": True, "fleet": hub.fleet, "robots": directory.robots(), "last_stop": hub.stop_all.last,
+            "forgotten": directory.recently_forgotten(), "forget_after_s": directory.forget_after_s}
 
 
 @bp.get("/api/robots")
@@ -44,10 +49,34 @@ def robots_page():
 @bp.get("/api/status")
 def status():
     hub = _hub()
-    lines = hub.directory.robots()
-    return jsonify({"hub": True, "fleet": hub.fleet, "robots": len(lines),
-                    "live": sum(1 for line in lines if line["heard"] == "live"),
-                    "forged_summaries": hub.directory.forged})
+    directory = hub.directory
+    counts = directory.counts()
+    return jsonify({"hub": True, "fleet": hub.fleet, "robots": sum(counts.values()), **counts,
+                    "forgotten": directory.forgotten_total, "forged_summaries": directory.forged,
+                    "stale_summaries": directory.stale})
+
+
+@bp.get("/api/robots/<name>/history")
+def robot_history(name: str):
+    """A robot's history, newest first; `before` (an id from `next_before`) pages back, `limit` ≤ 200."""
+    hub = _hub()
+    try:
+        before = _int_arg("before", 1, 2**62)
+        limit = _int_arg("limit", 1, PAGE_MAX)
+    except InvalidInput as exc:
+        raise ApiError(400, exc.code, str(exc)) from None
+    if not NAME.match(name) or (name not in hub.directory.names() and not hub.history.known(name)):
+        raise ApiError(404, "unknown_robot", f"the hub has no robot {name[:40]!r} heard or in its history")
+    return jsonify(hub.history.page(name, before=before, limit=limit or 50))
+
+
+def _int_arg(key: str, low: int, high: int) -> int | None:
+    raw = request.args.get(key)
+    if raw is None:
+        return None
+    if not raw.isdigit() or len(raw) > 19 or not low <= int(raw) <= high:
+        raise InvalidInput(f"{key} must be a whole number from {low} to {high}", "bad_value")
+    return int(raw)
 
 
 @bp.post("/api/estop/all")
@@ -66,8 +95,7 @@ def estop_all():
     except InvalidInput as exc:
         raise ApiError(400, exc.code, str(exc)) from None
     who = signed_in_name() or by or request.remote_addr or "unknown"
-    hub = _hub()
-    return jsonify(hub.stop_all.stop(hub.directory.names(), who[:NAME_MAX_LEN]))
+    return jsonify(_hub().stop_robots(who[:NAME_MAX_LEN]))
 
 
 @bp.get("/api/openapi.json")

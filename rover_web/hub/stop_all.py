@@ -62,7 +62,7 @@ class StopAll:
 
     def _believe(self, command: dict, payload: bytes) -> dict:
         try:
-            reply = json.loads(payload)
+            reply = json.loads(payload) if len(payload) <= signing.COMMAND_MAX_BYTES else None
         except ValueError:
             reply = None
         if not signing.answer_checks(self.key, command, reply):

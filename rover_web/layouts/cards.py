@@ -12,11 +12,15 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+# The end of the string, in a JSON Schema (ECMA) pattern that Python's re reads the same: `$` alone
+# also matches before a trailing newline in Python, so {"topic": "/a\n"} was stored (issue 40), and
+# ECMA has no \Z. "Nothing follows" is a negative lookahead on any character.
+END = r"(?![\s\S])"
 # The rules of a fully qualified ROS topic name (web/validate.py topic_name), as a JSON Schema pattern.
-TOPIC = {"type": "string", "maxLength": 247, "pattern": r"^(/[A-Za-z_][A-Za-z0-9_]*)+$"}
-TOPIC_OR_DEFAULT = {"type": "string", "maxLength": 247, "pattern": r"^((/[A-Za-z_][A-Za-z0-9_]*)+)?$",
+TOPIC = {"type": "string", "maxLength": 247, "pattern": r"^(/[A-Za-z_][A-Za-z0-9_]*)+" + END}
+TOPIC_OR_DEFAULT = {"type": "string", "maxLength": 247, "pattern": r"^((/[A-Za-z_][A-Za-z0-9_]*)+)?" + END,
                     "description": "\"\" for the robot's configured topic"}
-FIELD_PATH = {"type": "string", "minLength": 1, "maxLength": 200, "pattern": r"^[A-Za-z0-9_.\[\]]+$"}
+FIELD_PATH = {"type": "string", "minLength": 1, "maxLength": 200, "pattern": r"^[A-Za-z0-9_.\[\]]+" + END}
 LEVELS = ["DEBUG", "INFO", "WARN", "ERROR", "FATAL"]
 
 
@@ -55,7 +59,7 @@ CARDS: dict[str, CardType] = {c.name: c for c in (
     CardType("scan_the_code", "Scan the Code", "panels/scan_the_code.html", panel="panels/scan_the_code.html",
              size=(4, 6), min_size=(3, 3), help="the light buoy's sequence"),
     CardType("panel", "Mission panel", "panels/panels.html", panel="panels/panels.html", size=(4, 4),
-             settings=settings({"panel": {"type": "string", "maxLength": 64, "pattern": r"^([a-z][a-z0-9_-]*)?$",
+             settings=settings({"panel": {"type": "string", "maxLength": 64, "pattern": r"^([a-z][a-z0-9_-]*)?" + END,
                                           "description": "a panel's id; \"\" for every panel"}}),
              help="a mission control panel's light and status"),
     CardType("plot", "Plot", "cards/plot.html", once=False, channels=("plot",), size=(6, 4), min_size=(3, 3),
@@ -75,6 +79,10 @@ CARDS: dict[str, CardType] = {c.name: c for c in (
     CardType("node", "Node", "cards/node.html", size=(4, 4), help="rover_web's node and its topics"),
     CardType("link", "Link", "cards/link.html", size=(6, 3), min_size=(3, 2),
              help="round trip to the server and the age of the robot's newest message"),
+    # One per layout: each is a WebGL context, and browsers allow a page only a few (about 16).
+    CardType("view3d", "3D view", "cards/view3d.html", channels=("view3d", "view3d_robot", "view3d_markers"),
+             settings=settings({"fixed": {"enum": ["map", "odom", "robot"]}}), size=(6, 6), min_size=(3, 3),
+             help="the robot's model moved by TF, its markers and point cloud"),
 )}
 
 

@@ -45,7 +45,7 @@ LAYOUT_SCHEMA = {
         # Not blank; no control characters or lone surrogates (neither prints, and SQLite and the
         # page's UTF-8 cannot hold a surrogate).
         "name": {"type": "string", "minLength": 1, "maxLength": NAME_MAX,
-                 "pattern": "^(?=.*\\S)[^\\u0000-\\u001f\\u007f-\\u009f\\ud800-\\udfff]+$"},
+                 "pattern": "^(?=.*\\S)[^\\u0000-\\u001f\\u007f-\\u009f\\ud800-\\udfff]+(?![\\s\\S])"},
         "cards": {"type": "array", "maxItems": MAX_CARDS, "items": CARD_SCHEMA},
     },
     "required": ["version", "name", "cards"],

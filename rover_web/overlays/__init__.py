@@ -15,7 +15,8 @@ from __future__ import annotations
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
 
-from . import msgs, routes
+from . import bounds, msgs, routes
+from .bounds import bounded
 from .service import CHANNELS, COSTMAP_CHECK_S, TF_POSE_S, OverlayService
 
 MARKER_EXPIRY_S = 0.5
@@ -35,17 +36,28 @@ def _init_robot(rover: Rover) -> None:
     config = rover.config
     runtime.subscribe(msgs.AMCL_POSE, config["ROVER_WEB_AMCL_POSE_TOPIC"],
                       lambda m: service.on_pose(*msgs.amcl_pose(m)), "latched", track=False)
+    # The overlay topics are taken raw and their length checked before rclpy deserializes them;
+    # scans and markers only while a page watches (bounds.py, issue 40).
+    watching = rover.hub.watchers
     if service.scan_topic:
-        runtime.subscribe(msgs.LASER_SCAN, service.scan_topic, lambda m: service.on_scan(msgs.scan(m)), "sensor_data")
+        runtime.subscribe(msgs.LASER_SCAN, service.scan_topic, bounded(
+            service.counts["scan"], bounds.SCAN_MAX_BYTES, msgs.deserializer(msgs.LASER_SCAN),
+            lambda m: service.on_scan(msgs.scan(m)), lambda: watching("scan") > 0), "sensor_data", raw=True)
     for topic in service.costmap_topics:
         # Nav2 publishes its costmaps transient local: a page opened later still gets the global one.
-        runtime.subscribe(msgs.OCCUPANCY_GRID, topic, lambda m, t=topic: service.on_costmap(t, msgs.grid(m)),
-                          "latched")
+        runtime.subscribe(msgs.OCCUPANCY_GRID, topic, bounded(
+            service.counts["costmap"], bounds.grid_max_bytes(service.costmap_max_cells),
+            msgs.deserializer(msgs.OCCUPANCY_GRID), lambda m, t=topic: service.on_costmap(t, msgs.grid(m))),
+            "latched", raw=True)
     if service.markers_topic:
-        runtime.subscribe(msgs.MARKER_ARRAY, service.markers_topic, lambda m: service.on_markers(msgs.markers(m)), 10)
+        runtime.subscribe(msgs.MARKER_ARRAY, service.markers_topic, bounded(
+            service.counts["markers"], bounds.MARKERS_MAX_BYTES, msgs.deserializer(msgs.MARKER_ARRAY),
+            lambda m: service.on_markers(msgs.markers(m), len(m.markers) - bounds.MARKERS_MAX_COUNT),
+            lambda: watching("markers") > 0), 10, raw=True)
     if service.footprint_topic:
-        runtime.subscribe(msgs.POLYGON_STAMPED, service.footprint_topic,
-                          lambda m: service.on_footprint(*msgs.polygon(m)), 1)
+        runtime.subscribe(msgs.POLYGON_STAMPED, service.footprint_topic, bounded(
+            service.counts["footprint"], bounds.FOOTPRINT_MAX_BYTES, msgs.deserializer(msgs.POLYGON_STAMPED),
+            lambda m: service.on_footprint(*msgs.polygon(m))), 1, raw=True)
     if service.costmap_topics or service.footprint_topic:
         # Nav2's local costmap and footprint are in `odom`: placed with AMCL's map -> odom (frames.py),
         # from the /odom subscription telemetry already has (one, shared, raw).

@@ -59,6 +59,7 @@ def _finite(*values: float) -> bool:
 @dataclass
 class MarkerSet:
     max_points: int = 5000
+    max_markers: int = 1000  # zero-point markers (cubes) cost a dict each: the review grew 100,020 of them
     points: int = 0  # in all the markers kept, against max_points
     markers: dict[tuple[str, int], dict] = field(default_factory=dict)
     _expiry: dict[tuple[str, int], float] = field(default_factory=dict)
@@ -80,8 +81,10 @@ class MarkerSet:
             raise BadMarker("bad_action")
         if marker["type"] not in KINDS:
             raise BadMarker("unsupported_type")
-        drawn = self._project(marker, place if callable(place) else robot_frames(place))
         replaced = self.markers.get(key)
+        if replaced is None and len(self.markers) >= self.max_markers:
+            raise BadMarker("too_many_markers")
+        drawn = self._project(marker, place if callable(place) else robot_frames(place))
         used = self.points - (len(replaced["points"]) if replaced else 0)
         if used + len(drawn["points"]) > self.max_points:
             raise BadMarker("too_many_points")

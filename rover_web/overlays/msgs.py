@@ -7,6 +7,7 @@ import numpy as np
 from rover_web.livemap.msgs import occupancy_grid
 from rover_web.ros.convert import stamp_to_float, yaw_from_quaternion
 
+from .bounds import FRAME_ID_MAX, MARKERS_MAX_COUNT, NS_MAX, TEXT_MAX
 from .costmap import Grid
 from .scan import Scan
 
@@ -16,6 +17,16 @@ MARKER_ARRAY = "visualization_msgs/msg/MarkerArray"
 POLYGON_STAMPED = "geometry_msgs/msg/PolygonStamped"
 AMCL_POSE = "geometry_msgs/msg/PoseWithCovarianceStamped"
 ODOMETRY = "nav_msgs/msg/Odometry"
+
+
+def deserializer(type_name: str):
+    """bytes -> the message, for a raw subscription whose length was checked first (bounds.py)."""
+    from rclpy.serialization import deserialize_message
+
+    from rover_web.ros.typesupport import message_class
+
+    cls = message_class(type_name)
+    return lambda raw: deserialize_message(raw, cls)
 
 
 def _yaw(q) -> float:
@@ -34,18 +45,20 @@ def grid(msg) -> Grid:
                 info["resolution"], tuple(info["origin"]), cells)
 
 
-def markers(msg) -> list[dict]:
+def markers(msg, most: int = MARKERS_MAX_COUNT) -> list[dict]:
+    """The first `most` markers of the array as plain values (the rest are counted by the caller,
+    never converted), ns and text truncated."""
     out = []
-    for m in msg.markers:
+    for m in msg.markers[:most]:
         p = m.pose
         c = m.color
-        out.append({"ns": m.ns, "id": int(m.id), "type": int(m.type), "action": int(m.action),
-                    "frame_id": m.header.frame_id, "stamp": stamp_to_float(m.header.stamp),
+        out.append({"ns": m.ns[:NS_MAX], "id": int(m.id), "type": int(m.type), "action": int(m.action),
+                    "frame_id": m.header.frame_id[:FRAME_ID_MAX], "stamp": stamp_to_float(m.header.stamp),
                     "pose": (p.position.x, p.position.y, _yaw(p.orientation)),
                     "scale": (m.scale.x, m.scale.y, m.scale.z), "color": (c.r, c.g, c.b, c.a),
                     "points": [(q.x, q.y) for q in m.points],
                     "colors": [(k.r, k.g, k.b, k.a) for k in m.colors],
-                    "text": m.text, "lifetime_s": m.lifetime.sec + m.lifetime.nanosec * 1e-9})
+                    "text": m.text[:TEXT_MAX], "lifetime_s": m.lifetime.sec + m.lifetime.nanosec * 1e-9})
     return out
 
 

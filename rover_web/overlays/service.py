@@ -238,9 +238,12 @@ class OverlayService:
 
     # --- markers ---
 
-    def on_markers(self, markers: list[dict]) -> None:
+    def on_markers(self, markers: list[dict], over: int = 0) -> None:
+        """`over`: markers of the array past the count cap, never converted (bounds.py)."""
         counts = self.counts["markers"]
         counts.receive()
+        if over > 0:
+            counts.skip("too_many_markers", over)
         if not markers:
             counts.skip("empty")
             return

@@ -27,25 +27,16 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from mcap.data_stream import ReadDataStream
 from mcap.exceptions import McapError
-from mcap.opcode import Opcode
-from mcap.records import Channel, Chunk, Message, Schema
+from mcap.records import Channel, Footer, Message, Schema
 from mcap_ros2.decoder import DecoderFactory
 
-from .reading import MAGIC, NotARecording, cut_or_damaged, read_messages
+from . import bounds
+from .bounds import Budget, TooCostly
+from .reading import MAGIC, NotARecording, Refused, cut_or_damaged, read_messages
 
 CACHED_FILES = 8
 _RECORD_HEAD = struct.Struct("<BQ")  # opcode, content length
-
-
-class Refused(NotARecording):
-    """A file refused by walk(strict=True) (and one that is not MCAP at all, by any walk): `code`
-    is not_mcap, truncated or corrupt."""
-
-    def __init__(self, code: str, message: str):
-        super().__init__(message)
-        self.code = code
 
 
 @dataclass(frozen=True)
@@ -103,19 +94,23 @@ class FileIndex:
             if channel_id not in self._decoders:
                 channel = self.channels.get(channel_id)
                 decode = None
+                schema = self.schemas.get(channel.schema_id) if channel is not None else None
                 if channel is not None:
                     try:
-                        decode = self._factory.decoder_for(channel.message_encoding,
-                                                           self.schemas.get(channel.schema_id))
+                        if schema is not None and bounds.amplifies(schema.name, schema.data.decode()):
+                            raise ValueError("an array of messages smaller than their Python objects")
+                        decode = self._factory.decoder_for(channel.message_encoding, schema)
                     except Exception:  # noqa: BLE001 - a schema it cannot parse: not shown, not a 500
                         decode = None
                 self._decoders[channel_id] = decode
             return self._decoders[channel_id]
 
-    def decode(self, message: Message):
-        """The decoded message, or None when its channel cannot be decoded or its bytes are damaged."""
+    def decode(self, message: Message, most: int | None = bounds.DECODE_MAX):
+        """The decoded message, or None when its channel cannot be decoded, its bytes are damaged, or
+        it is longer than `most` bytes (decoded into Python objects, a message costs tens of times
+        its size: only camera frames, decoded one at a time, are let past bounds.DECODE_MAX)."""
         decode = self.decoder(message.channel_id)
-        if decode is None:
+        if decode is None or (most is not None and len(message.data) > most):
             return None
         try:
             return decode(message.data)
@@ -124,13 +119,19 @@ class FileIndex:
 
     # --- reading ---
 
+    def budget(self) -> Budget:
+        """A new allowance for one question of this file (bounds.py)."""
+        return Budget(self.path.stat().st_size)
+
     def messages(self, topics: Iterable[str], start_ns: int | None = None,
-                 end_ns: int | None = None) -> Iterator[tuple[Channel, Message]]:
+                 end_ns: int | None = None, budget: Budget | None = None) -> Iterator[tuple[Channel, Message]]:
         """The messages of `topics` with start_ns <= log time <= end_ns, chunk by chunk in the
-        order of their start (roughly in time: callers that need strict order sort)."""
+        order of their start (roughly in time: callers that need strict order sort); under
+        `budget` (one of its own when None): TooCostly over a bound."""
         ids = self.channel_ids(topics)
         if not ids:
             return
+        budget = budget or self.budget()
         if self.loose:
             for _schema, channel, message in read_messages(self.path):
                 if channel.id in ids and _within(message.log_time, start_ns, end_ns):
@@ -139,7 +140,7 @@ class FileIndex:
         chunks = [c for c in self.chunks if c.channels & ids and _overlaps(c, start_ns, end_ns)]
         with open(self.path, "rb") as f:
             for chunk in sorted(chunks, key=lambda c: (c.start_ns, c.offset)):
-                for record in self._read_chunk(f, chunk):
+                for record in self._read_chunk(f, chunk, ids, budget):
                     if isinstance(record, Message) and record.channel_id in ids \
                             and _within(record.log_time, start_ns, end_ns):
                         yield self.channels[record.channel_id], record
@@ -158,23 +159,25 @@ class FileIndex:
         best: Message | None = None
         candidates = sorted((c for c in self.chunks if c.channels & ids and c.start_ns <= t_ns),
                             key=lambda c: c.end_ns, reverse=True)
+        budget = self.budget()
         with open(self.path, "rb") as f:
             for chunk in candidates:
                 if best is not None and best.log_time >= chunk.end_ns:
                     break  # every chunk left ends before what was found
-                for record in self._read_chunk(f, chunk):
+                for record in self._read_chunk(f, chunk, ids, budget):
                     if isinstance(record, Message) and record.channel_id in ids and record.log_time <= t_ns \
                             and (best is None or record.log_time >= best.log_time):
                         best = record
         return None if best is None else (self.channels[best.channel_id], best)
 
-    @staticmethod
-    def _read_chunk(f, chunk: ChunkRef) -> list:
-        from mcap.stream_reader import breakup_chunk  # with lz4 and zstandard: see reading.py
-
-        f.seek(chunk.offset + _RECORD_HEAD.size)
+    def _read_chunk(self, f, chunk: ChunkRef, ids: set[int], budget: Budget) -> list:
+        """The chunk's records, bounded (bounds.py); the offset must hold a Chunk record, whatever
+        a summary said (the review's bomb sat in an Attachment its chunk index pointed at)."""
         try:
-            return breakup_chunk(Chunk.read(ReadDataStream(f)), validate_crc=True)
+            content = bounds.read_chunk(f, chunk.offset, budget.file_size, budget)
+            return list(bounds.parse_records(content, ids.__contains__, budget))
+        except TooCostly:
+            raise
         except cut_or_damaged():
             return []  # the chunk the index pass read is damaged now: nothing from it
 
@@ -191,7 +194,9 @@ def _overlaps(chunk: ChunkRef, start_ns: int | None, end_ns: int | None) -> bool
 
 
 def from_summary(path: Path) -> FileIndex | None:
-    """The index of a finished file from its summary; None when it has none to use."""
+    """The index of a finished file from its summary; None when it has none to use. Only for files
+    this server wrote (index_of's trust_summary): a summary from elsewhere can point its chunk
+    index anywhere, so those files are walked."""
     try:
         with open(path, "rb") as f:
             if f.read(len(MAGIC)) != MAGIC or not _ends_with_magic(f):
@@ -204,6 +209,11 @@ def from_summary(path: Path) -> FileIndex | None:
     if summary is None or not summary.chunk_indexes or summary.statistics is None \
             or not all(ci.message_index_offsets for ci in summary.chunk_indexes):
         return None  # nothing to tell which chunk holds which channel: the pass over the file will
+    try:
+        for schema in summary.schemas.values():
+            bounds.check_schema(schema)
+    except TooCostly:
+        return None  # the walk says which bound, and refuses
     index = FileIndex(path, complete=True, schemas=dict(summary.schemas), channels=dict(summary.channels),
                       counts=dict(summary.statistics.channel_message_counts))
     for ci in summary.chunk_indexes:
@@ -229,10 +239,11 @@ def walk(path: Path, strict: bool = False) -> FileIndex:
                 raise Refused("truncated", "the file is cut short: it does not end with MCAP's closing magic bytes "
                                            "(a copy or download that stopped early, or a recording cut by a crash; "
                                            "`mcap recover` rewrites such a file whole)")
-            f.seek(len(MAGIC))
             index = FileIndex(path, complete=False)
             try:
                 _walk_records(f, size, index)
+            except TooCostly:
+                raise
             except cut_or_damaged() as exc:
                 if strict:
                     raise Refused("corrupt", f"the file is damaged at byte {f.tell()} "
@@ -256,40 +267,33 @@ def _ends_with_magic(f) -> bool:
 
 
 def _walk_records(f, size: int, index: FileIndex) -> None:
-    from mcap.stream_reader import breakup_chunk
+    chunk_at: int | None = None
+    channels: set[int] = set()
+    times: list[int] = []
 
-    while True:
-        head = f.read(_RECORD_HEAD.size)
-        if len(head) < _RECORD_HEAD.size:
-            return  # cut between records
-        opcode, length = _RECORD_HEAD.unpack(head)
-        at = f.tell()
-        if at + length > size:
-            return  # cut inside this record
-        stream = ReadDataStream(f)
-        if opcode == Opcode.CHUNK:
-            records = breakup_chunk(Chunk.read(stream), validate_crc=True)
-            channels: set[int] = set()
-            for record in records:
-                if isinstance(record, Message):
-                    channels.add(record.channel_id)
-                    _count(index, record)
+    def close_chunk() -> None:
+        if chunk_at is not None and channels:
+            index.chunks.append(ChunkRef(chunk_at, min(times), max(times), frozenset(channels)))
+
+    try:
+        for located in bounds.records(f, size, Budget(size), wanted=lambda _channel: False):
+            if located.chunk_offset != chunk_at:
+                close_chunk()
+                chunk_at, channels, times = located.chunk_offset, set(), []
+            record = located.record
+            if isinstance(record, Message):
+                if located.chunk_offset is None:
+                    index.loose = True
                 else:
-                    _describe(index, record)
-            if channels:
-                times = [r.log_time for r in records if isinstance(r, Message)]
-                index.chunks.append(ChunkRef(at - _RECORD_HEAD.size, min(times), max(times), frozenset(channels)))
-        elif opcode == Opcode.SCHEMA:
-            _describe(index, Schema.read(stream))
-        elif opcode == Opcode.CHANNEL:
-            _describe(index, Channel.read(stream))
-        elif opcode == Opcode.MESSAGE:
-            index.loose = True
-            _count(index, Message.read(stream, length))
-        elif opcode == Opcode.FOOTER:
-            index.complete = True
-            return
-        f.seek(at + length)
+                    channels.add(record.channel_id)
+                    times.append(record.log_time)
+                _count(index, record)
+            elif isinstance(record, Footer):
+                index.complete = True
+            else:
+                _describe(index, record)
+    finally:
+        close_chunk()  # the last whole chunk before a cut or a damaged one
 
 
 def _describe(index: FileIndex, record) -> None:
@@ -318,9 +322,10 @@ def _key(path: Path) -> tuple:
     return str(path), stat.st_size, stat.st_mtime_ns
 
 
-def index_of(path: Path) -> FileIndex:
-    """The file's index, built once (from its summary, else by a pass over it); NotARecording for a
-    file that is not MCAP or has nothing readable."""
+def index_of(path: Path, trust_summary: bool = False) -> FileIndex:
+    """The file's index, built once (from its summary when trust_summary, i.e. this server wrote
+    the file; else by a pass over it); NotARecording for a file that is not MCAP or has nothing
+    readable, TooCostly over a bound."""
     try:
         key = _key(path)
     except OSError as exc:
@@ -335,7 +340,7 @@ def index_of(path: Path) -> FileIndex:
             if key in _cache:
                 return _cache[key]
         try:
-            index = from_summary(path) or walk(path)
+            index = (from_summary(path) if trust_summary else None) or walk(path)
             remember(path, index, key)
         finally:
             with _cache_lock:

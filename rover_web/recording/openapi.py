@@ -23,7 +23,10 @@ RECORDING = obj({
     "source": {"enum": ["recorded", "uploaded"]},
 }, ("id", "state", "started_at", "size", "topics", "counts"), closed=False)
 NOT_FOUND = {404: "not_found"}
-READABLE = {404: "not_found", 409: "recording_in_progress", 422: "not_a_recording"}
+# A file over one of recording/bounds.py's bounds (issue 40), met while reading it: the code names it.
+BOUNDS = ("chunk_too_large, read_budget, time_budget, message_too_large, schema_too_large, "
+          "schema_too_many_fields, corrupt")
+READABLE = {404: "not_found", 409: "recording_in_progress", 422: "not_a_recording, " + BOUNDS}
 TOPIC = query("topic", {"type": "string", "maxLength": 256}, "a topic of the recording", required=True)
 TIME = query("t", {"type": "number", "minimum": 0}, "the time to show, in seconds since the epoch (as the "
              "timeline's start and end)", required=True)
@@ -144,7 +147,7 @@ PATHS = {
                    errors={400: "bad_name, upload_incomplete",
                            413: "upload_too_large (ROVER_WEB_RECORDING_UPLOAD_MAX_MB), request_entity_too_large",
                            415: "unsupported_media_type (send Content-Type: application/octet-stream)",
-                           422: "not_mcap, truncated, corrupt, not_ros2",
+                           422: "not_mcap, truncated, corrupt, not_ros2, " + BOUNDS,
                            507: "folder_full, disk_low, cannot_write"},
                    description="The body is the file itself (Content-Type: application/octet-stream), at most "
                                "ROVER_WEB_RECORDING_UPLOAD_MAX_MB. It is stored only once read whole and found "

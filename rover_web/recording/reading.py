@@ -36,6 +36,15 @@ class NotARecording(ValueError):
     """Not an MCAP file at all, or damaged before its first message; the message says which."""
 
 
+class Refused(NotARecording):
+    """A file refused by a strict read (file_index.walk) or over a bound (bounds.TooCostly): `code`
+    is not_mcap, truncated, corrupt or the bound's name."""
+
+    def __init__(self, code: str, message: str):
+        super().__init__(message)
+        self.code = code
+
+
 @dataclass
 class Outcome:
     complete: bool = False  # the footer was read: the file was finished properly
@@ -45,19 +54,21 @@ class Outcome:
 def read_messages(path: Path, outcome: Outcome | None = None) -> Iterator[tuple[Schema | None, Channel, Message]]:
     """Every message in file order, with its channel and schema; stops quietly at a cut end
     (outcome.complete says whether the footer was there). NotARecording for anything that is
-    not MCAP; a damaged chunk in the middle ends the reading like a cut."""
-    from mcap.stream_reader import StreamReader
+    not MCAP; a damaged chunk in the middle ends the reading like a cut. Under the bounds of
+    bounds.py: bounds.TooCostly (a Refused) for a file over one, wherever it is met."""
+    from .bounds import Budget, TooCostly, records
 
     outcome = outcome if outcome is not None else Outcome()
     try:
         with open(path, "rb") as f:
             if f.read(len(MAGIC)) != MAGIC:
                 raise NotARecording(f"{path} is not an MCAP file (it does not start with the MCAP magic bytes)")
-            f.seek(0)
+            size = f.seek(0, 2)
             schemas: dict[int, Schema] = {}
             channels: dict[int, Channel] = {}
             try:
-                for record in StreamReader(f, validate_crcs=True).records:
+                for located in records(f, size, Budget(size)):
+                    record = located.record
                     if isinstance(record, Schema):
                         schemas[record.id] = record
                     elif isinstance(record, Channel):
@@ -70,6 +81,10 @@ def read_messages(path: Path, outcome: Outcome | None = None) -> Iterator[tuple[
                         yield schemas.get(channel.schema_id), channel, record
                     elif isinstance(record, Footer):
                         outcome.complete = True
+                if not outcome.complete and outcome.messages == 0 and not channels:
+                    raise NotARecording(f"{path} is cut before its first message")
+            except TooCostly:
+                raise
             except cut_or_damaged() as exc:
                 if outcome.messages == 0 and not channels:
                     raise NotARecording(f"{path} is damaged before its first message ({type(exc).__name__})") \

@@ -4,8 +4,16 @@ As `ros2 bag play` does: each message's CDR bytes go out unchanged (rclpy publis
 serialized message), at its recorded log time relative to the first one, divided by --rate. It
 runs its own rclpy context and node (the CLI never starts the app's), so a team can rehearse with
 real data and no robot. The audit channel (/rover_web/audit) is only replayed when named in --topics:
-it was never a ROS topic. /tf_static goes out transient local, as tf2's static broadcasters
-publish it (its subscribers match nothing else).
+it was never a ROS topic.
+
+Motion and safety are left out unless --include-motion (issue 40): a recording's /cmd_vel would drive
+a robot listening on the domain, and its /e_stop would release one engaged since; an uploaded file
+comes from elsewhere. Left out: the app's own ROVER_WEB_CMD_VEL_TOPIC and ROVER_WEB_ESTOP_TOPIC, any
+topic named cmd_vel*, e_stop or estop, any Twist or TwistStamped, and anything of an action (its
+hidden `/_action/` topics, goal types). Each one left out is said on stderr.
+
+/tf_static goes out transient local, as tf2's static broadcasters publish it (its subscribers match
+nothing else).
 """
 
 from __future__ import annotations
@@ -18,6 +26,16 @@ from flask import Flask, current_app
 
 NODE_NAME = "rover_web_replay"
 AUDIT_TOPIC = "/rover_web/audit"
+MOTION_TYPES = frozenset({"geometry_msgs/msg/Twist", "geometry_msgs/msg/TwistStamped", "geometry_msgs/Twist",
+                          "geometry_msgs/TwistStamped"})
+SAFETY_NAMES = ("e_stop", "estop", "emergency_stop")
+
+
+def moves_or_stops(topic: str, type_name: str, own: tuple[str, ...] = ()) -> bool:
+    """True for a topic whose replay could move a robot or change its e-stop."""
+    leaf = topic.rstrip("/").rsplit("/", 1)[-1].lower()
+    return (topic in own or leaf.startswith("cmd_vel") or leaf in SAFETY_NAMES or type_name in MOTION_TYPES
+            or "/_action/" in topic or type_name.endswith(("_Goal", "_SendGoal_Request", "_SendGoal_Event")))
 
 
 def init_cli(app: Flask) -> None:
@@ -30,12 +48,18 @@ def init_cli(app: Flask) -> None:
                   help="only these topics (repeat the option, or separate with commas); default: all but the audit")
     @click.option("--delay", type=click.FloatRange(0, 60), default=1.0, show_default=True,
                   help="seconds between making the publishers and the first message, for subscribers to match")
-    def replay(file: Path, rate: float, loop: bool, topics: tuple[str, ...], delay: float):
+    @click.option("--include-motion", is_flag=True,
+                  help="also publish velocity commands, e-stop and action topics (left out by default: they "
+                       "would move or release a robot on this domain)")
+    def replay(file: Path, rate: float, loop: bool, topics: tuple[str, ...], delay: float, include_motion: bool):
         """Publish FILE's messages (an MCAP recording) with their original timing."""
         from rover_web.recording.reading import NotARecording
 
         wanted = {t.strip() for entry in topics for t in entry.replace(",", " ").split() if t.strip()}
-        player = _Player(current_app.config.get("ROVER_WEB_ROS_DOMAIN_ID"), rate, wanted, delay)
+        config = current_app.config
+        own = None if include_motion else (config.get("ROVER_WEB_CMD_VEL_TOPIC") or "/cmd_vel",
+                                           config.get("ROVER_WEB_ESTOP_TOPIC") or "/e_stop")
+        player = _Player(config.get("ROVER_WEB_ROS_DOMAIN_ID"), rate, wanted, delay, own)
         try:
             while True:
                 cut_short, sent = player.play_once(file)
@@ -48,7 +72,7 @@ def init_cli(app: Flask) -> None:
                                                f"complete chunk")
                 if not loop:
                     break
-        except NotARecording as exc:
+        except NotARecording as exc:  # bounds.TooCostly too: the file costs more than a read may
             raise click.ClickException(str(exc)) from None
         except KeyboardInterrupt:
             click.echo("replay stopped")
@@ -64,9 +88,11 @@ def _static_tf(type_name: str, topic: str) -> bool:
 
 
 class _Player:
-    def __init__(self, domain_id: int | None, rate: float, wanted: set[str], delay: float):
+    def __init__(self, domain_id: int | None, rate: float, wanted: set[str], delay: float,
+                 motion_topics: tuple[str, ...] | None = None):
         from rover_web.ros.raw import RawPublisherNode
 
+        self.motion_topics = motion_topics  # None: motion and safety included (--include-motion)
         self.rate = rate
         self.wanted = wanted
         self.delay = delay
@@ -82,6 +108,11 @@ class _Player:
             return found
         if (self.wanted and channel.topic not in self.wanted) or (not self.wanted and channel.topic == AUDIT_TOPIC) \
                 or channel.message_encoding != "cdr" or schema is None:
+            self._skipped.add(channel.topic)
+            return None
+        if self.motion_topics is not None and moves_or_stops(channel.topic, schema.name, self.motion_topics):
+            click.echo(f"skipping {channel.topic} ({schema.name}): motion or safety, replayed only with "
+                       f"--include-motion", err=True)
             self._skipped.add(channel.topic)
             return None
         try:

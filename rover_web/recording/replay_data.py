@@ -166,9 +166,11 @@ def _diagnostics_log(index: FileIndex) -> _DiagnosticsLog:
     topics = [t for t, info in index.topics().items() if info["type"] == DIAGNOSTIC_ARRAY]
     stride = stride_for(index.count(topics), DIAG_ARRAYS)
     rows = []
-    for i, (channel, message) in enumerate(index.messages(topics)):
+    budget = index.budget()
+    for i, (channel, message) in enumerate(index.messages(topics, budget=budget)):
         if i % stride:
             continue
+        budget.check_time()
         decoded = index.decode(message)
         if decoded is None:
             continue
@@ -231,7 +233,7 @@ def frame_at(index: FileIndex, topic: str, t: float, quality: int, width: int | 
 
 
 def _encode(index: FileIndex, message, type_name: str, quality: int, width, height, max_pixels) -> Jpeg:
-    decoded = index.decode(message)
+    decoded = index.decode(message, most=None)  # one frame, of a type without arrays of messages: bounded
     if decoded is None:
         return error_frame("this frame cannot be decoded", "not_decodable", width, height, 0.0, max_pixels)
     try:

@@ -13,12 +13,12 @@ from flask import Response, jsonify, render_template, request
 
 from rover_web.core.state import current_feature
 from rover_web.plot.field import FieldError
-from rover_web.web.http import ApiError, accepts_media, body_limit
+from rover_web.web.http import ApiError, accepts_media, body_limit, error_response
 from rover_web.web.validate import InvalidInput, topic_name
 
 from . import replay_data, upload
 from .file_index import FileIndex, index_of
-from .reading import NotARecording
+from .reading import NotARecording, Refused
 from .routes import MAX_NAME, _by, _id, _service, bp
 from .service import MB
 from .timeline import timeline_of
@@ -32,7 +32,10 @@ def _readable(recording_id: str) -> FileIndex:
     if status["state"] == "recording":
         raise ApiError(409, "recording_in_progress", "the file is still being written: stop the recording first")
     try:
-        return index_of(service.path_of(recording_id))
+        # A summary is believed only in a file this server recorded itself (bounds.py, issue 40).
+        return index_of(service.path_of(recording_id), trust_summary=status["source"] == "recorded")
+    except Refused as exc:
+        raise ApiError(422, exc.code, str(exc)) from None
     except NotARecording as exc:
         raise ApiError(422, "not_a_recording", str(exc)) from None
 
@@ -63,6 +66,12 @@ def _int_arg(name: str, code: str, low: int, high: int, default: int | None) -> 
     if not raw.isdigit() or not low <= int(raw) <= high:
         raise ApiError(400, code, f"{name} is a whole number from {low} to {high}, not {raw[:20]!r}")
     return int(raw)
+
+
+@bp.errorhandler(Refused)
+def _refused(exc: Refused):
+    """A file over one of bounds.py's bounds, met while answering (a chunk the index did not open)."""
+    return error_response(422, exc.code, str(exc))
 
 
 def _not_shown(exc: replay_data.NotShown) -> ApiError:
@@ -100,7 +109,9 @@ def replay_page(recording_id: str):
 def recording_timeline(recording_id: str):
     index = _readable(recording_id)
     try:
-        return jsonify(id=recording_id, **timeline_of(index.path))
+        return jsonify(id=recording_id, **timeline_of(index))
+    except Refused as exc:
+        raise ApiError(422, exc.code, str(exc)) from None
     except NotARecording as exc:
         raise ApiError(422, "not_a_recording", str(exc)) from None
 

@@ -13,6 +13,7 @@ import secrets
 import shutil
 import threading
 import time
+from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -70,6 +71,7 @@ class RecordingService:
         self._audit_hubs = [rover.audit, *[hub for hub in extra_audit if hub is not rover.audit]]
         self._lock = threading.Lock()
         self._active: _Active | None = None
+        self.stops: Counter[str] = Counter()  # recordings ended, by stop_reason: for /metrics (rover_web/metrics)
         self._taker: RawTaker | None = None  # made at the first recording
         index.reconcile(folder, rover.robot.name)
         upload.clear_incoming(folder)
@@ -262,6 +264,7 @@ class RecordingService:
         with self._lock:
             if self._active is active:
                 self._active = None
+        self.stops[recorder.stop_reason or "unknown"] += 1
         if recorder.stop_reason not in ("requested", "shutdown"):
             log.warning("recording %s stopped: %s", recorder.path.stem, recorder.stop_reason)
 

@@ -16,12 +16,12 @@ import json
 import math
 import threading
 from collections import OrderedDict
-from pathlib import Path
 
 from rover_web.livemap.msgs import path_points, pose_from_amcl, pose_from_stamped
 from rover_web.ros.convert import yaw_from_quaternion
 
-from .file_index import FileIndex, index_of, stride_for
+from .bounds import Budget
+from .file_index import FileIndex, stride_for
 
 AUDIT_TOPIC = "/rover_web/audit"
 MAX_POINTS = 5000
@@ -91,12 +91,12 @@ SHOWN = {
 SERIES = ("fix", "odom", "pose", "plan")
 
 
-def timeline(path: Path) -> dict:
+def timeline(index: FileIndex) -> dict:
     """{"start", "end" (s since the epoch), "complete", "topics": {topic: {type, count, decodable}},
     "series": {"fix"|"odom"|"pose"|"plan": {topic: [...]}}, "thinned": {topic: kept of n},
     "logs": [...], "audit": [...]}; each item has `t`, in time order. NotARecording for a file
-    that is not one."""
-    index = index_of(path)
+    that is not one; bounds.TooCostly for one that costs more than a read may (one budget for all)."""
+    budget = index.budget()
     series: dict[str, dict[str, list]] = {kind: {} for kind in SERIES}
     logs: list[dict] = []
     audit: list[dict] = []
@@ -108,7 +108,7 @@ def timeline(path: Path) -> dict:
             kind, convert, most = SHOWN[info["type"]]
         else:
             continue
-        items = decode_sampled(index, topic, convert, most)
+        items = decode_sampled(index, topic, convert, most, budget)
         if len(items) < info["count"]:
             thinned[topic] = f"{len(items)} of {info['count']}"
         if kind == "audit":
@@ -123,14 +123,17 @@ def timeline(path: Path) -> dict:
             "topics": index.topics(), "series": series, "thinned": thinned, "logs": logs, "audit": audit}
 
 
-def decode_sampled(index: FileIndex, topic: str, convert, most: int) -> list[dict]:
+def decode_sampled(index: FileIndex, topic: str, convert, most: int, budget: Budget | None = None) -> list[dict]:
     """convert(decoded) of at most `most` of the topic's messages, every k-th chosen before
-    decoding, each with its log time `t` (s), sorted by it; None from convert leaves one out."""
+    decoding, each with its log time `t` (s), sorted by it; None from convert leaves one out.
+    Under `budget` (bounds.py): its time is checked at each message decoded."""
     stride = stride_for(index.count([topic]), most)
+    budget = budget or index.budget()
     items = []
-    for i, (_channel, message) in enumerate(index.messages([topic])):
+    for i, (_channel, message) in enumerate(index.messages([topic], budget=budget)):
         if i % stride:
             continue
+        budget.check_time()
         decoded = index.decode(message)
         if decoded is None:
             continue
@@ -160,15 +163,15 @@ _answers: OrderedDict[tuple, dict] = OrderedDict()
 _answers_lock = threading.Lock()
 
 
-def timeline_of(path: Path) -> dict:
-    """timeline(path), kept for the last few files (a finished file never changes)."""
-    stat = path.stat()
-    key = (str(path), stat.st_size, stat.st_mtime_ns)
+def timeline_of(index: FileIndex) -> dict:
+    """timeline(index), kept for the last few files (a finished file never changes)."""
+    stat = index.path.stat()
+    key = (str(index.path), stat.st_size, stat.st_mtime_ns)
     with _answers_lock:
         if key in _answers:
             _answers.move_to_end(key)
             return _answers[key]
-    answer = timeline(path)
+    answer = timeline(index)
     with _answers_lock:
         _answers[key] = answer
         while len(_answers) > CACHED:

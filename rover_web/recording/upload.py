@@ -82,7 +82,8 @@ def receive(service, request, name: str, by: str) -> dict:
 def _copy(stream, part: Path, limit: int) -> int:
     size = 0
     try:
-        with open(part, "xb") as out:
+        # 0600 from its creation (the folder is 0700): an upload is someone's data until it is checked.
+        with os.fdopen(os.open(part, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600), "wb") as out:
             while True:
                 block = stream.read(BLOCK)
                 if not block:

@@ -81,6 +81,10 @@ def _fill(msg: Any, data: dict[str, Any]) -> None:
             setattr(msg, name, items)
         elif fields[name] in ("byte", "octet") and isinstance(value, int):
             setattr(msg, name, bytes([value]))  # JSON has no bytes; rclpy wants b"\x01" for a ROS byte
+        elif fields[name] in ("float", "double") and isinstance(value, int) and not isinstance(value, bool):
+            # JSON's 4 is an int: rclpy (field checks off) keeps it and its C side then reads the int
+            # object as a double, sending 2e-323 for 4 and NaN for -1
+            setattr(msg, name, float(value))
         else:
             setattr(msg, name, value)
 

@@ -305,6 +305,7 @@ class TeleopController:
             held = self._command is not None
             for session in self._sessions:
                 session.armed = False
+            self.stats["link_stops"] += 1  # for /metrics (rover_web/metrics)
             self._stop("link_lost", bump=list(self._sessions))
             if held:
                 self._changed()

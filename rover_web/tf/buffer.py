@@ -210,10 +210,7 @@ class _Frame:
         self.unnormalised = 0
         self.last_norm2 = 1.0
 
-    def newest(self) -> int:
-        return self.stamps[-1] if self.stamps else 0
-
-    def at(self, stamp_ns: int) -> tuple[Vector, Quaternion] | None | tuple[str, int]:
+    def at(self, stamp_ns: int) -> tuple[Vector, Quaternion] | tuple[str, int]:
         """The value at a stamp, interpolated; or ("past"|"future", nearest stamp)."""
         stamps = self.stamps
         if self.static or stamp_ns == 0:

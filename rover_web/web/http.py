@@ -11,7 +11,7 @@ from werkzeug.middleware.proxy_fix import ProxyFix
 
 from .validate import InvalidInput, loads_strict
 
-JSON_PREFIXES = ("/api/", "/ws/", "/stream", "/snapshot")
+JSON_PREFIXES = ("/api/", "/ws/", "/stream", "/snapshot", "/metrics")  # /metrics: Prometheus gets 401, not a page
 STATE_CHANGING = frozenset({"POST", "PUT", "PATCH", "DELETE"})
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from rover_web.core.fleet import Fleet
 
-from .session import link_settings
+from .session import link_settings, own_url
 
 __all__ = ["init_app", "check_settings"]
 
@@ -29,7 +29,7 @@ def init_app(fleet: Fleet) -> None:
         return
     from .robot import TICK_S, RobotLink
 
-    robot_link = RobotLink(fleet, link, settings["ROVER_WEB_PUBLIC_URL"], settings["ROVER_WEB_FLEET_COMMAND_WINDOW_S"])
+    robot_link = RobotLink(fleet, link, own_url(settings), settings["ROVER_WEB_FLEET_COMMAND_WINDOW_S"])
     fleet.first.every(TICK_S, robot_link.tick, name="zenoh-link", immediately=True)
     fleet.first.on_shutdown(robot_link.close)
     fleet.first.add_feature(robot_link)

@@ -148,8 +148,8 @@ class RobotLink:
     def stop_answer(self, rover: Rover, name: str, payload: bytes) -> dict:
         """Check the command; engage the e-stop if it holds; the signed answer either way."""
         key, fleet = self.link.key, self.link.fleet
-        try:
-            command = json.loads(payload) if payload else None
+        try:  # oversized: refused as malformed, unparsed (anyone on the Zenoh network may send it)
+            command = json.loads(payload) if payload and len(payload) <= signing.COMMAND_MAX_BYTES else None
         except ValueError:
             command = None
         nonce = command.get("nonce") if isinstance(command, dict) and isinstance(command.get("nonce"), str) else ""

@@ -72,6 +72,24 @@ def link_settings(settings: dict[str, Any]) -> LinkSettings | None:
                         load_key(settings["ROVER_WEB_FLEET_KEY_FILE"]))
 
 
+def own_url(settings: dict[str, Any]) -> str | None:
+    """Where others reach this rover_web: ROVER_WEB_PUBLIC_URL, else ROVER_WEB_HOST and _PORT when
+    the host is a concrete address (not 0.0.0.0 or ::, which name no one machine), https when it
+    serves TLS; None when neither says."""
+    if settings["ROVER_WEB_PUBLIC_URL"]:
+        return settings["ROVER_WEB_PUBLIC_URL"]
+    # gunicorn.conf.py may leave a list here ("127.0.0.1,::1"): the first concrete one is as good as any.
+    hosts = [h.strip() for h in (settings.get("ROVER_WEB_HOST") or "").split(",")]
+    concrete = [h for h in hosts if h and h.strip("[]") not in ("0.0.0.0", "::", "*") and not set(h) & set("/@?#")]
+    if not concrete:
+        return None
+    host = concrete[0]
+    if ":" in host and not host.startswith("["):
+        host = f"[{host}]"  # an IPv6 address in a URL
+    scheme = "https" if settings.get("ROVER_WEB_TLS_CERT") else "http"
+    return f"{scheme}://{host}:{settings['ROVER_WEB_PORT']}"
+
+
 def zenoh_config(link: LinkSettings):
     import zenoh
 

@@ -34,6 +34,7 @@ class LightRobot:
         config.insert_json5("scouting/multicast/enabled", "false")
         config.insert_json5("connect/endpoints", json.dumps([endpoint]))
         self.session = zenoh.open(config)
+        self.endpoint = endpoint
         self.engaged = False
         self.position = None
         self.guard = signing.ReplayGuard(10.0)
@@ -72,6 +73,7 @@ class LightRobot:
 def hub(app_factory, tmp_path):
     key = tmp_path / "fleet.key"
     key.write_bytes(KEY)
+    key.chmod(0o600)
     endpoint = f"tcp/127.0.0.1:{free_port()}"
     app = app_factory(ROVER_WEB_HUB=True, ROVER_WEB_ZENOH_MODE="peer", ROVER_WEB_ZENOH_LISTEN=[endpoint],
                       ROVER_WEB_FLEET_KEY_FILE=str(key))
@@ -145,3 +147,85 @@ def test_the_hub_map_shows_a_robot_where_it_is_links_it_and_dims_it_once_lost(hu
         lost.click()
     assert page.url == ALPHA_URL
     assert page.watch.console_errors == [] and page.watch.offhost == []
+
+
+class Crowd:
+    """Robots r00..r{n-1} of fleet `fleet` from one Zenoh session (a token and a summary each, every
+    0.5 s), half of them at one spot, the others 40 m apart on a line: the page must keep every marker
+    visible and the table usable."""
+
+    def __init__(self, endpoint: str, n: int):
+        import zenoh
+
+        config = zenoh.Config()
+        config.insert_json5("mode", '"client"')
+        config.insert_json5("scouting/multicast/enabled", "false")
+        config.insert_json5("connect/endpoints", json.dumps([endpoint]))
+        self.session = zenoh.open(config)
+        self.names = [f"r{i:02d}" for i in range(n)]
+        self.tokens = [self.session.liveliness().declare_token(f"rover_web/fleet/{name}/alive") for name in self.names]
+        self.publishers = {name: self.session.declare_publisher(f"rover_web/fleet/{name}/summary")
+                           for name in self.names}
+        self.done = threading.Event()
+        self.thread = threading.Thread(target=self._publish, daemon=True)
+        self.thread.start()
+
+    def _publish(self) -> None:
+        seq = 0
+        while True:
+            seq += 1
+            for i, name in enumerate(self.names):
+                position = ALPHA_AT if i % 2 else {"lng": ALPHA_AT["lng"] + 0.0004 * i, "lat": ALPHA_AT["lat"]}
+                summary = {"title": name, "url": None, "link": "ok", "mode": "idle", "estop": {"engaged": False},
+                           "battery": {"percent": 90.0 - i / 2, "voltage": None}, "position": position, "alerts": []}
+                self.publishers[name].put(signing.signed_summary(KEY, "fleet", name, seq, summary))
+            if self.done.wait(0.5):
+                return
+
+    def close(self) -> None:
+        self.done.set()
+        self.thread.join(5)
+        for declared in (*self.publishers.values(), *self.tokens):
+            declared.undeclare()
+        self.session.close()
+
+
+def test_a_hundred_robots_a_sortable_filterable_table_markers_apart_and_a_robot_s_history(hub, strict_page):
+    url, robot = hub
+    crowd = Crowd(robot.endpoint, 100)
+    page = strict_page
+    try:
+        page.goto(url + "/robots")
+        page.wait_for_function("document.querySelectorAll('#hub-table tbody tr[data-heard=\"live\"]').length === 101",
+                               timeout=15000)
+        assert "101 robots: 101 live, 0 waiting, 0 lost" in page.inner_text("#hub-counts")
+        # Sorted by battery: r99 (40.5 %) first, then ascending; again: descending.
+        page.click("button.hub-sort[data-sort='battery']")
+        page.wait_for_function("document.querySelector('#hub-table tbody tr').dataset.robot === 'r99'")
+        page.click("button.hub-sort[data-sort='battery']")
+        page.wait_for_function("document.querySelector('#hub-table tbody tr').dataset.robot === 'r00'")
+        assert page.get_attribute("#hub-table th:has(button[data-sort='battery'])", "aria-sort") == "descending"
+        page.fill("#hub-filter", "r07")
+        page.wait_for_function("document.querySelectorAll('#hub-table tbody tr').length === 1")
+        assert page.locator("#hub-table tbody tr").get_attribute("data-robot") == "r07"
+        assert "1 shown" in page.inner_text("#hub-counts")
+        # Markers: 50 robots share one spot, and not one dot hides another.
+        page.wait_for_selector("#hub-map[data-ready='yes']", timeout=10000)
+        page.wait_for_function("document.querySelectorAll('.fleet-marker').length === 100", timeout=10000)
+        assert "fleet-crowded" in page.get_attribute("#hub-map", "class")
+        boxes = page.evaluate("""() => [...document.querySelectorAll('.fleet-marker-dot')]
+            .map((d) => d.getBoundingClientRect()).map((r) => [r.x, r.y, r.width, r.height])""")
+        overlaps = [(a, b) for i, a in enumerate(boxes) for b in boxes[i + 1:]
+                    if a[0] < b[0] + b[2] and b[0] < a[0] + a[2] and a[1] < b[1] + b[3] and b[1] < a[1] + a[3]]
+        assert overlaps == []
+        # A robot's history: its state changes, newest first.
+        page.fill("#hub-filter", "")
+        page.click("#hub-table tr[data-robot='r03'] button.hub-history-open")
+        page.locator("#hub-history-list li[data-event='live']").wait_for(timeout=5000)
+        assert page.text_content("#hub-history-name") == "r03"
+        events = page.eval_on_selector_all("#hub-history-list li", "els => els.map((e) => e.dataset.event)")
+        assert events[-1] == "found" and "live" in events
+        assert page.watch.console_errors == [] and page.watch.offhost == []
+        assert page.evaluate("window.__csp") == []
+    finally:
+        crowd.close()

@@ -87,6 +87,42 @@ def filter_candidates(sdp: str, allowed: Iterable[str] | None) -> str:
     return "\r\n".join(kept) + "\r\n"
 
 
+MAX_REMOTE_CANDIDATES = 12  # a browser on wifi and cellular, IPv4 and IPv6, host and reflexive: under 10
+_REMOTE = re.compile(r"^a=candidate:\S+ \d+ \S+ \d+ (\S+) (\d+) typ ")
+
+
+def unusable_remote(address: str, port: int) -> str | None:
+    """Why a remote candidate is not worth a connectivity check (each costs STUN requests to a place
+    the client chose: the review's 300 candidates made 1,428), or None."""
+    if port == 0 or port < 1024:
+        return "port"
+    try:
+        ip = ipaddress.ip_address(address)
+    except ValueError:
+        return "name"  # not an IP literal: resolving it would be a DNS query the client chose (.local: mDNS)
+    if ip.is_multicast or ip.is_unspecified:
+        return "multicast" if ip.is_multicast else "unspecified"
+    if ip.version == 4 and (ip == ipaddress.IPv4Address("255.255.255.255") or address.endswith(".255")):
+        return "broadcast"  # the limited broadcast, and the usual /24's directed one
+    return None
+
+
+def screen_remote_candidates(offer: str) -> tuple[str, int, int]:
+    """The offer with at most MAX_REMOTE_CANDIDATES usable candidates, the others dropped:
+    (offer, kept, dropped)."""
+    lines = offer.split("\n")
+    kept_lines, kept, dropped = [], 0, 0
+    for line in lines:
+        match = _REMOTE.match(line.strip())
+        if match:
+            if kept >= MAX_REMOTE_CANDIDATES or unusable_remote(match.group(1), int(match.group(2))):
+                dropped += 1
+                continue
+            kept += 1
+        kept_lines.append(line)
+    return "\n".join(kept_lines), kept, dropped
+
+
 def candidates(sdp: str) -> list[tuple[str, str]]:
     return [found for line in sdp.splitlines() if (found := candidate_address(line))]
 

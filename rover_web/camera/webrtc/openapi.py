@@ -7,7 +7,8 @@ WHEP_PARAMS = [p for p in PARAMS if p["name"] in ("topic", "width", "height", "q
 
 _offer = op("WHEP: answer an SDP offer with the camera's video (and the teleop data channel)", tag="camera",
             status=201, media="application/sdp", ok={"type": "string"}, params=WHEP_PARAMS,
-            errors={**BODY_ERRORS, 400: BAD + ", bad_sdp, no_video, cannot_subscribe", 404: "unknown_topic",
+            errors={**BODY_ERRORS, 400: BAD + ", bad_sdp, no_video, no_usable_candidates, cannot_subscribe",
+                    404: "unknown_topic",
                     503: "too_many_webrtc_viewers (use GET /stream), too_many_producers, too_many_streams, "
                          "webrtc_timeout, shutting_down"},
             description="The body is the SDP offer (Content-Type: application/sdp) with a recvonly video section "

@@ -44,7 +44,14 @@ from rover_web.web.validate import InvalidInput
 from . import frames
 from .adapt import AdaptPolicy
 from .feedback import tap_rtcp
-from .ice import candidate_address, check_addresses, filter_candidates, only_host_addresses, parse_ice_server
+from .ice import (
+    candidate_address,
+    check_addresses,
+    filter_candidates,
+    only_host_addresses,
+    parse_ice_server,
+    screen_remote_candidates,
+)
 from .loop import LoopStopped, LoopThread
 
 if TYPE_CHECKING:
@@ -275,6 +282,10 @@ class WebRtcService:
             raise InvalidInput("the body is not an SDP offer (it must start with v=0)", "bad_sdp")
         if "\nm=video " not in offer.replace("\r\n", "\n"):
             raise NoVideo("the offer has no video media section: add a recvonly video transceiver", "no_video")
+        offer, kept, dropped = screen_remote_candidates(offer)
+        if dropped and not kept:
+            raise InvalidInput("none of the offer's ICE candidates can be checked (multicast, broadcast, unspecified "
+                               "or named addresses, or ports below 1024)", "no_usable_candidates")
         session = self._reserve(key, user, role, may_operate, slot)
         try:
             client = session.client

@@ -1,9 +1,12 @@
 // The fleet's GPS map, shared by the fleet page (fleet.js: the robots of one rover_web) and the hub's
-// page (hub.js: robots heard over Zenoh): one marker per robot with a position, each a link to its
+// page (hub/page.js: robots heard over Zenoh): one marker per robot with a position, each a link to its
 // own rover_web, framed until the operator moves the map. The page gives it GET /api/robots's robots
 // on each poll. A robot the hub has lost (`heard: 'lost'`) stays where it was last seen, dimmed.
 // Untrusted text (titles) only ever goes through textContent; a URL is followed only if http(s)
-// (a path on this server is too).
+// (a path on this server is too). With many robots (a hub of 100) markers must not hide each other:
+// a marker whose dot would cover another's moves to the nearest free place on rings around its
+// point (each still opens its own robot), and past CROWDED markers the names show only on hover or focus.
+// A robot the hub forgot leaves the map with the list.
 import { createGpsMap, fmtLatLng } from '../gps_map.js';
 
 // 'engaged', 'released', or 'unknown' (a robot the hub has heard no summary from yet).
@@ -62,6 +65,9 @@ function showOnMarker(node, robot) {
 // The map in `container` (its data-config: the server's map config), or null when this browser
 // cannot show one: then `note` says so and the page's table goes on alone. render(robots) places
 // every robot; robots given before the map has loaded are placed once it has.
+const CROWDED = 20;  // markers beyond which names are shown on hover and focus only
+const APART_PX = 20;  // dots (14 px when crowded, 18 px else) kept at least this far apart
+
 export function createFleetMap(container, note) {
   const markers = new Map();  // robot name -> maplibregl.Marker
   let userMoved = false;  // once the operator pans or zooms, the map stops framing the robots itself
@@ -99,11 +105,42 @@ export function createFleetMap(container, note) {
     map.fitBounds(bounds, { padding, maxZoom: 17, duration: 0 });
   }
 
+  // Dots that would overlap on screen: each marker, in name order, keeps its own point if it is free,
+  // else takes the nearest free one on rings around it (6 on the first, 12 on the second, ...).
+  function spread() {
+    const placed = [];
+    const free = (x, y) => placed.every(([px, py]) => Math.hypot(px - x, py - y) >= APART_PX);
+    for (const name of [...markers.keys()].sort()) {
+      const marker = markers.get(name);
+      const p = map.project(marker.getLngLat());
+      let at = [p.x, p.y];
+      for (let ring = 1; !free(...at) && ring < 12; ring += 1) {
+        const count = 6 * ring;
+        for (let i = 0; i < count; i += 1) {
+          const angle = (2 * Math.PI * i) / count;
+          const candidate = [p.x + ring * APART_PX * Math.cos(angle), p.y + ring * APART_PX * Math.sin(angle)];
+          if (free(...candidate)) { at = candidate; break; }
+        }
+      }
+      placed.push(at);
+      const dx = Math.round(at[0] - p.x);
+      const dy = Math.round(at[1] - p.y);
+      marker.setOffset([-9 + dx, dy]);
+      marker.getElement().dataset.spread = dx || dy ? 'yes' : 'no';
+    }
+    container.classList.toggle('fleet-crowded', markers.size > CROWDED);
+  }
+
   function render(robots) {
     latest = robots;
     if (!ready) return;
+    const names = new Set(robots.map((r) => r.name));
+    for (const [name, marker] of markers) {
+      if (!names.has(name)) { marker.remove(); markers.delete(name); }  // forgotten by the hub
+    }
     for (const robot of robots) place(robot);
     frame(robots);
+    spread();
   }
 
   try {
@@ -118,5 +155,6 @@ export function createFleetMap(container, note) {
   for (const start of ['dragstart', 'zoomstart']) {
     map.on(start, (e) => { if (e.originalEvent) userMoved = true; });
   }
+  map.on('zoomend', () => { if (ready) spread(); });
   return { map, render };
 }

@@ -76,6 +76,7 @@ def hub_rig(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("hub")
     key_file = tmp / "fleet.key"
     key_file.write_text(secrets.token_hex(32) + "\n")
+    key_file.chmod(0o600)
     hub_db = tmp / "hub.sqlite3"
     tokens = add_users(hub_db)
     endpoint = f"tcp/127.0.0.1:{free_port()}"

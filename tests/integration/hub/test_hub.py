@@ -113,6 +113,17 @@ def test_stop_all_engages_every_robot_as_the_hub_user(hub_rig):
             assert (state["engaged"], state["by"], state["via"]) == (True, "viewer", "hub")
         page = requests.get(hub_rig.hub.url + "/robots", headers=hub_rig.headers(), timeout=5).text
         assert "alpha: engaged" in page and "bravo: engaged" in page
+        # Each robot's history on the hub: the stop-all's answer, and the e-stop it saw engaged, by whom.
+        def history(name):
+            return requests.get(f"{hub_rig.hub.url}/api/robots/{name}/history", headers=hub_rig.headers(),
+                                timeout=5).json()["events"]
+
+        for name in ("alpha", "bravo"):
+            assert {"by": "viewer", "result": "engaged"} in [e["detail"] for e in history(name)
+                                                              if e["event"] == "stop_all"]
+            wait_until(lambda name=name: {"by": "viewer"} in [e["detail"] for e in history(name)
+                                                               if e["event"] == "estop_engaged"],
+                       timeout=3, what=f"{name}'s e-stop in its history")
     finally:
         for name in ("alpha", "bravo"):
             hub_rig.release(name)

@@ -22,6 +22,7 @@ from tests.support.auth import add_users, bearer
 def hub_app(app_factory, tmp_path):
     key = tmp_path / "fleet.key"
     key.write_text("k" * 64)
+    key.chmod(0o600)
     db = tmp_path / "hub.sqlite3"
     tokens = add_users(db)
     app = app_factory(ROVER_WEB_HUB=True, ROVER_WEB_ZENOH_MODE="peer", ROVER_WEB_FLEET_KEY_FILE=str(key),
@@ -49,6 +50,7 @@ def test_stop_all_takes_any_signed_in_user_as_on_a_robot(hub_app):
 def test_building_a_hub_imports_no_ros(tmp_path):
     key = tmp_path / "fleet.key"
     key.write_text("k" * 64)
+    key.chmod(0o600)
     settings = {"TESTING": True, "ROVER_WEB_HUB": True, "ROVER_WEB_ZENOH_MODE": "peer",
                 "ROVER_WEB_FLEET_KEY_FILE": str(key), "ROVER_WEB_ZENOH_LISTEN": [f"tcp/127.0.0.1:{free_port()}"],
                 "ROVER_WEB_DB_PATH": str(tmp_path / "hub.sqlite3"), "ROVER_WEB_SECRET_KEY": "x" * 40,
@@ -67,6 +69,7 @@ def test_a_hub_that_cannot_serve_ends_rather_than_hangs(tmp_path):
 
     key = tmp_path / "fleet.key"
     key.write_text("k" * 64)
+    key.chmod(0o600)
     with socket.socket() as taken:
         taken.bind(("127.0.0.1", 0))
         taken.listen()
@@ -105,6 +108,7 @@ def test_the_hub_map_has_the_robots_basemap_and_serves_its_tiles(app_factory, tm
 
     key = tmp_path / "fleet.key"
     key.write_text("k" * 64)
+    key.chmod(0o600)
     tile, tiles = b"\x89PNG\r\n\x1a\n" + b"\0" * 16, tmp_path / "tiles"
     FolderTiles(tiles).put(12, 1110, 1720, tile, "png")
     FolderTiles(tiles).update_metadata(bounds=[-82.5, 27.3, -82.4, 27.4], minzoom=12, maxzoom=12,

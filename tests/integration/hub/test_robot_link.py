@@ -24,6 +24,7 @@ def test_a_hub_needs_zenoh(app_factory):
 def test_a_robot_whose_zenoh_is_unreachable_works_alone(app_factory, tmp_path):
     key = tmp_path / "fleet.key"
     key.write_text("k" * 64)
+    key.chmod(0o600)
     # A client with nothing to connect to: the session cannot open, and the link keeps retrying.
     app = app_factory(ROVER_WEB_ZENOH_MODE="client", ROVER_WEB_ZENOH_CONNECT=[f"tcp/127.0.0.1:{free_port()}"],
                       ROVER_WEB_FLEET_KEY_FILE=str(key))

@@ -66,6 +66,12 @@ BAD = [
      "unknown_field"),
     ("bad topic", changed(BOAT, ["cards", 0, "settings", "topic"], "no spaces allowed"), "cards[0].settings.topic",
      "bad_value"),
+    ("a topic ending in a newline", changed(BOAT, ["cards", 0, "settings", "topic"], "/a\n"),
+     "cards[0].settings.topic", "bad_value"),  # `$` matched before it: stored, then the card failed
+    ("a plot field ending in a newline",
+     {**BOAT, "cards": [{"type": "plot", "x": 0, "y": 0, "w": 4, "h": 4,
+                         "settings": {"series": [{"topic": "/odom", "field": "pose.x\n"}]}}]},
+     "cards[0].settings.series[0].field", "bad_value"),
     ("plot without series", {**BOAT, "cards": [{"type": "plot", "x": 0, "y": 0, "w": 4, "h": 4, "settings": {}}]},
      "cards[0].settings.series", "missing_field"),
     ("overlap", changed(BOAT, ["cards", 3, "x"], 7), "cards[3]", "overlap"),

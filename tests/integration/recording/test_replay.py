@@ -77,3 +77,48 @@ def test_a_cut_file_replays_what_survived_and_then_fails_saying_so(tmp_path):
     head.write_bytes(whole[:60])
     done = replay(head, "--delay", "0")
     assert done.returncode == 1 and "damaged before its first message" in done.stderr
+
+
+def motion_recording(path):
+    from geometry_msgs.msg import Twist
+    from std_msgs.msg import Bool
+
+    rec = Recorder(path, {"/replay/chatter": "std_msgs/msg/String", "/cmd_vel": "geometry_msgs/msg/Twist",
+                          "/e_stop": "std_msgs/msg/Bool", "/nav/cmd": "geometry_msgs/msg/Twist"},
+                   limits=ROOMY, queue_size=100, metadata={"id": "t"})
+    t0 = 1_700_000_000_000_000_000
+    for i in range(N):
+        rec.offer("/replay/chatter", serialize_message(String(data=f"m{i}")), t0 + i * STEP_NS)
+        rec.offer("/cmd_vel", serialize_message(Twist()), t0 + i * STEP_NS)
+        rec.offer("/nav/cmd", serialize_message(Twist()), t0 + i * STEP_NS)
+        rec.offer("/e_stop", serialize_message(Bool(data=False)), t0 + i * STEP_NS)
+    rec.stop("requested")
+    return path
+
+
+def test_replay_leaves_motion_and_safety_out_unless_asked(ros_peer, tmp_path):
+    path = motion_recording(tmp_path / "m.mcap")
+    peer = ros_peer("replay_motion_listener")
+    for topic, type_name in (("/replay/chatter", "std_msgs/msg/String"), ("/cmd_vel", "geometry_msgs/msg/Twist"),
+                             ("/nav/cmd", "geometry_msgs/msg/Twist"), ("/e_stop", "std_msgs/msg/Bool")):
+        peer.subscribe(topic, type_name, qos=50)
+    done = replay(path, "--rate", "4", "--delay", "3")
+    assert done.returncode == 0, done.stderr
+    assert "skipping /cmd_vel" in done.stderr and "skipping /e_stop" in done.stderr
+    assert "--include-motion" in done.stderr
+    peer.wait_for("/replay/chatter", lambda m: m["data"] == f"m{N - 1}", timeout=5)
+    assert peer.received("/cmd_vel") == [] and peer.received("/e_stop") == [] and peer.received("/nav/cmd") == []
+    done = replay(path, "--rate", "4", "--delay", "3", "--include-motion")
+    assert done.returncode == 0, done.stderr
+    peer.wait_for("/e_stop", lambda m: m["data"] is False, timeout=5)
+    peer.wait_for("/cmd_vel", lambda m: True, timeout=5)
+    peer.wait_for("/nav/cmd", lambda m: True, timeout=5)
+
+
+def test_a_file_over_a_reading_bound_is_refused_before_anything_is_published(tmp_path):
+    from tests.support import hostile_mcap as hostile
+
+    path = hostile.zstd_bomb(tmp_path / "bomb.mcap", held=200 * (1 << 20))  # its one message is in the bomb
+    done = replay(path, "--delay", "0")
+    assert done.returncode == 1, done.stdout
+    assert "Error:" in done.stderr and "chunk" in done.stderr and "replayed" not in done.stdout

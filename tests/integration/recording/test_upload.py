@@ -133,3 +133,48 @@ def test_operators_upload_viewers_only_replay(signed_server, tmp_path):
         answer = requests.get(f"{signed_server.url}/api/recordings/{made.json()['id']}/{what}", params=params,
                               headers=viewer, timeout=10)
         assert answer.status_code == 200, (what, answer.text)
+
+
+def test_the_part_file_is_private_from_its_creation(tmp_path):
+    import io
+    import os
+
+    from rover_web.recording.upload import _copy
+
+    old = os.umask(0o022)  # a usual umask: open()'s default mode would leave the file 0644
+    try:
+        _copy(io.BytesIO(b"some bytes"), tmp_path / "x.part", 100)
+    finally:
+        os.umask(old)
+    assert (tmp_path / "x.part").stat().st_mode & 0o777 == 0o600
+
+
+def test_the_review_s_hostile_files_are_refused_with_the_bound_named(live_server, tmp_path):
+    from tests.support import hostile_mcap as hostile
+
+    mib = 1 << 20
+    cases = {hostile.zstd_bomb(tmp_path / "zstd.mcap", held=200 * mib): "chunk_too_large",
+             hostile.lz4_bomb(tmp_path / "lz4.mcap", held=200 * mib): "chunk_too_large",
+             hostile.many_fields(tmp_path / "fields.mcap"): "schema_too_large",
+             hostile.many_fields(tmp_path / "fields3k.mcap", fields=3000): "schema_too_many_fields",
+             hostile.many_chunks(tmp_path / "chunks.mcap"): "read_budget",
+             hostile.amplification(tmp_path / "amplify.mcap"): "not_ros2"}  # nothing it holds can be decoded
+    for path, code in cases.items():
+        answer = upload(live_server, path)
+        assert refused(answer) == (422, code), (path.name, answer.text)
+    assert left_in(live_server) == []
+
+
+def test_an_uploaded_file_s_summary_is_not_believed(live_server, tmp_path):
+    from rover_web.recording import file_index
+    from tests.support import hostile_mcap as hostile
+
+    path = hostile.attachment_bomb(tmp_path / "attachment.mcap", held=100 * (1 << 20))
+    answer = upload(live_server, path)
+    assert answer.status_code == 201, answer.text
+    made = answer.json()
+    file_index.forget(folder_of(live_server) / f"{made['id']}.mcap")  # as after a restart: the index is built again
+    timeline = requests.get(f"{live_server.url}/api/recordings/{made['id']}/timeline", timeout=20)
+    assert timeline.status_code == 200, timeline.text
+    walked = file_index.index_of(folder_of(live_server) / f"{made['id']}.mcap")  # the one the timeline built
+    assert [c.offset for c in walked.chunks] == [c.offset for c in file_index.walk(path).chunks]  # not the attachment

@@ -207,3 +207,17 @@ def test_poll_returns_what_changed_since_the_last_poll_whatever_the_polling_patt
         log.append((len(log) + 1, op, channel, i))
         check("every", every)
     check("sometimes", sometimes)
+
+
+def test_watchers_counts_the_open_streams_of_each_channel():
+    hub = EventHub()
+    hub.register("markers", "scan", "odom")
+    a = hub.subscribe(["markers", "odom"])
+    b = hub.subscribe(["markers"])
+    assert (hub.watchers("markers"), hub.watchers("odom"), hub.watchers("scan")) == (2, 1, 0)
+    a.close()
+    a.close()  # twice: counted once
+    assert (hub.watchers("markers"), hub.watchers("odom")) == (1, 0)
+    with b:
+        pass
+    assert hub.watchers("markers") == 0 and hub.client_count == 0

@@ -25,6 +25,7 @@ def test_on_without_a_key_file_is_refused():
 def test_bad_values_are_named(tmp_path):
     key = tmp_path / "fleet.key"
     key.write_text("k" * 32)
+    key.chmod(0o600)
     with pytest.raises(ConfigError, match="ROVER_WEB_FLEET_NAME"):
         link_settings(settings(ZENOH_MODE="peer", FLEET_KEY_FILE=str(key), FLEET_NAME="Bad/Name"))
     with pytest.raises(ConfigError, match="ROVER_WEB_ZENOH_CONNECT"):
@@ -40,6 +41,7 @@ def test_bad_values_are_named(tmp_path):
 def test_on_with_a_key(tmp_path):
     key = tmp_path / "fleet.key"
     key.write_text("k" * 40)
+    key.chmod(0o600)
     link = link_settings(settings(ZENOH_MODE="client", FLEET_KEY_FILE=str(key), ZENOH_CONNECT=["tcp/127.0.0.1:7447"]))
     assert (link.mode, link.connect, link.fleet, link.key, link.multicast_scouting) == (
         "client", ["tcp/127.0.0.1:7447"], "fleet", b"k" * 40, False)

@@ -121,11 +121,29 @@ def test_a_summary_opens_only_with_the_key_and_unchanged():
     assert opened == {"robot": "alpha", "seq": 7, "sent": NOW, "summary": {"mode": "idle"}}
     assert signing.open_summary(OTHER_KEY, "fleet", payload) is None
     assert signing.open_summary(KEY, "other", payload) is None
-    envelope = json.loads(payload)
-    envelope["summary"] = json.dumps({"mode": "estop"})
-    assert signing.open_summary(KEY, "fleet", json.dumps(envelope).encode()) is None
+    head, _, envelope = payload.rpartition(b".{")
+    changed = json.loads(b"{" + envelope)
+    changed["summary"] = {"mode": "estop"}
+    forged = head + b"." + json.dumps(changed, separators=(",", ":"), sort_keys=True).encode()
+    assert signing.open_summary(KEY, "fleet", forged) is None
     assert signing.open_summary(KEY, "fleet", b"not json") is None
     assert signing.open_summary(KEY, "fleet", b"{}") is None
+
+
+def test_a_summary_s_signature_is_checked_before_its_json_is_parsed(monkeypatch):
+    """Issue 40: a forged payload costs one HMAC, never a JSON parse; an oversized one not even that."""
+    parsed = []
+    real_loads = json.loads
+    monkeypatch.setattr(signing.json, "loads", lambda data, *a, **k: parsed.append(len(data)) or real_loads(data))
+    forged = signing.signed_summary(OTHER_KEY, "fleet", "alpha", 1, {"mode": "idle", "pad": "x" * 60000}, now=NOW)
+    assert signing.open_summary(KEY, "fleet", forged) is None
+    assert signing.open_summary(KEY, "fleet", b'{"fleet": "fleet", "summary": "' + b"x" * 50000 + b'"}') is None
+    assert parsed == []
+    huge = signing.signed_summary(KEY, "fleet", "alpha", 1, {"pad": "x" * signing.SUMMARY_MAX_BYTES}, now=NOW)
+    hmacs = []
+    monkeypatch.setattr(signing, "_summary_mac", lambda key, env: hmacs.append(1) or b"")
+    assert signing.open_summary(KEY, "fleet", huge) is None
+    assert (parsed, hmacs) == ([], [])  # refused by its size alone
 
 
 def test_the_key_file_is_required_and_long_enough(tmp_path):
@@ -135,8 +153,22 @@ def test_the_key_file_is_required_and_long_enough(tmp_path):
         signing.load_key(str(tmp_path / "missing"))
     short = tmp_path / "short.key"
     short.write_text("abc\n")
+    short.chmod(0o600)
     with pytest.raises(ConfigError, match="holds 3 bytes"):
         signing.load_key(str(short))
     good = tmp_path / "fleet.key"
     good.write_text("a" * 64 + "\n")
+    good.chmod(0o600)
     assert signing.load_key(str(good)) == b"a" * 64
+
+
+@pytest.mark.parametrize("mode", [0o644, 0o640, 0o604, 0o620, 0o660])
+def test_a_key_file_others_may_read_or_write_is_refused(tmp_path, mode):
+    """Issue 40: the database's mode was checked, the fleet key's was not; it is refused (ssh's rule)."""
+    key = tmp_path / "fleet.key"
+    key.write_text("a" * 64)
+    key.chmod(mode)
+    with pytest.raises(ConfigError, match=rf"may be read or written by others \(mode {mode:o}\): chmod 600"):
+        signing.load_key(str(key))
+    key.chmod(0o400)
+    assert signing.load_key(str(key)) == b"a" * 64

@@ -110,6 +110,7 @@ def test_bad_offers_get_4xx_json_and_leak_nothing(webrtc_server, camera, whep, r
         (url + f"?topic=/cam&{IMAGE}", _without_video(offer), sdp, 400, "no_video"),
         (url + f"?topic=/cam&{IMAGE}", offer.replace("a=ice-ufrag:", "a=x-nothing:"), sdp, 400, "bad_sdp"),
         (url + f"?topic=/cam&{IMAGE}", _without_fingerprints(offer), sdp, 400, "bad_sdp"),
+        (url + f"?topic=/cam&{IMAGE}", _only_hostile_candidates(offer), sdp, 400, "no_usable_candidates"),
     ]
     for target, body, headers, status, code in cases:
         response = requests.post(target, data=body, headers=headers, timeout=15)
@@ -242,3 +243,60 @@ def test_shutdown_closes_every_session(webrtc_server, camera, whep):
     wait_until(lambda: not udp_ports() or all(not c.pc or c.connection_state == "closed" for c in clients), 5,
                "sockets")
     time.sleep(0)
+
+
+def _candidate_lines(offer: str) -> list[str]:
+    return [line for line in offer.split("\r\n") if line.startswith("a=candidate:")]
+
+
+def _with_candidates(offer: str, extra: list[str], drop_own: bool = False) -> str:
+    """The offer with `extra` candidate lines where its first candidate is (its own dropped if asked)."""
+    lines = offer.split("\r\n")
+    at = next(i for i, line in enumerate(lines) if line.startswith("a=candidate:"))
+    kept = [line for line in lines if not (drop_own and line.startswith("a=candidate:"))]
+    return "\r\n".join(kept[:at] + extra + kept[at:])
+
+
+def _only_hostile_candidates(offer: str) -> str:
+    return _with_candidates(offer, ["a=candidate:9 1 udp 2130706431 224.0.0.251 5353 typ host",
+                                    "a=candidate:8 1 udp 2130706431 127.0.0.1 53 typ host",
+                                    "a=candidate:7 1 udp 2130706431 255.255.255.255 9999 typ host"], drop_own=True)
+
+
+def test_an_offer_s_remote_candidates_are_capped(webrtc_server, camera):
+    """The review's offer with 300 candidates had the robot send STUN to 300 ports the client chose:
+    here 40 listening sockets are offered, and at most MAX_REMOTE_CANDIDATES of them hear anything."""
+    import socket
+
+    from rover_web.camera.webrtc.ice import MAX_REMOTE_CANDIDATES
+
+    server = webrtc_server()
+    camera("/cam", width=160, height=120, hz=30)
+    sockets = []
+    for _ in range(40):
+        s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        s.bind(("127.0.0.1", 0))
+        s.setblocking(False)
+        sockets.append(s)
+    try:
+        extra = [f"a=candidate:x{i} 1 udp 2130706431 127.0.0.1 {s.getsockname()[1]} typ host"
+                 for i, s in enumerate(sockets)]
+        response = requests.post(server.url + f"/api/camera/whep?topic=/cam&{IMAGE}",
+                                 data=_with_candidates(_real_offer(), extra, drop_own=True),
+                                 headers={"Content-Type": "application/sdp"}, timeout=15)
+        assert response.status_code == 201, response.text
+        heard: set[int] = set()
+        deadline = time.monotonic() + 4.0  # aioice checks each pair several times in its first seconds
+        while time.monotonic() < deadline:
+            for i, s in enumerate(sockets):
+                try:
+                    while s.recv(2048):
+                        heard.add(i)
+                except BlockingIOError:
+                    pass
+            time.sleep(0.05)
+        assert 0 < len(heard) <= MAX_REMOTE_CANDIDATES, heard
+        requests.delete(server.url + response.headers["Location"], timeout=10)
+    finally:
+        for s in sockets:
+            s.close()

@@ -61,3 +61,21 @@ def test_gathering_uses_only_the_chosen_addresses():
     # Outside the block, aioice's own choice again (every interface but loopback; this machine
     # may have none, so only "not restricted to ours" is checked).
     assert ("127.0.0.1", "host") not in gathered(None)
+
+
+def test_remote_candidates_are_screened_and_capped():
+    from rover_web.camera.webrtc.ice import MAX_REMOTE_CANDIDATES, screen_remote_candidates
+
+    hostile = [f"a=candidate:h{i} 1 udp 2130706431 {address} {port} typ host"
+               for i, (address, port) in enumerate([("224.0.0.251", 5353), ("255.255.255.255", 4000),
+                                                    ("192.168.1.255", 4000), ("0.0.0.0", 4000), ("::", 4000),
+                                                    ("ff02::1", 4000), ("127.0.0.1", 0), ("127.0.0.1", 53),
+                                                    ("printer.local", 4000), ("example.com", 4000)])]
+    many = [f"a=candidate:m{i} 1 udp 2130706431 127.0.0.1 {20000 + i} typ host" for i in range(300)]
+    offer = "\r\n".join(["v=0", "m=video 9 UDP/TLS/RTP/SAVPF 96", *hostile, *many, "a=end-of-candidates", ""])
+    screened, kept, dropped = screen_remote_candidates(offer)
+    assert (kept, dropped) == (MAX_REMOTE_CANDIDATES, len(hostile) + 300 - MAX_REMOTE_CANDIDATES)
+    assert candidates(screened) == [("127.0.0.1", "host")] * MAX_REMOTE_CANDIDATES
+    only_hostile = "\r\n".join(["v=0", "m=video 9 UDP/TLS/RTP/SAVPF 96", *hostile, ""])
+    assert screen_remote_candidates(only_hostile)[1:] == (0, len(hostile))
+    assert screen_remote_candidates(SDP) == (SDP, 3, 0)  # an ordinary offer is left as it is

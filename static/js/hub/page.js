@@ -1,43 +1,23 @@
 // The fleet hub's page (templates/hub.html): polls GET /api/robots once a second while shown, and
 // "Stop all" posts POST /api/estop/all, then shows each robot's answer (engaged, refused, no_answer).
-// Its map is the fleet page's (static/js/fleet/map.js): each robot with a position, dimmed once lost.
-import { api } from './api.js';
-import { createFleetMap, estopState } from './fleet/map.js';
+// The table (table.js) sorts and filters; a row's "history" opens the robot's history (history.js);
+// the map is the fleet page's (static/js/fleet/map.js): each robot with a position, dimmed once lost.
+import { api } from '../api.js';
+import { createFleetMap } from '../fleet/map.js';
+import { createHistory } from './history.js';
+import { createTable } from './table.js';
 
-const table = document.querySelector('#hub-table tbody');
 const lastStop = document.getElementById('hub-last-stop');
+const forgotten = document.getElementById('hub-forgotten');
 const button = document.getElementById('hub-stop-all');
+const table = createTable(document.getElementById('hub-table'), document.getElementById('hub-filter'),
+                          document.getElementById('hub-counts'));
+const history = createHistory(document.getElementById('hub-history'));
 
-function cell(text) {
-  const td = document.createElement('td');
-  td.textContent = text;
-  return td;
-}
-
-function estopText(robot) {
-  const state = estopState(robot);
-  return state === 'unknown' ? '—' : state;
-}
-
-function row(r) {
-  const tr = document.createElement('tr');
-  tr.dataset.robot = r.name;
-  tr.dataset.heard = r.heard;
-  const name = document.createElement('td');
-  if (r.url) {
-    const a = document.createElement('a');
-    a.href = r.url;
-    a.textContent = r.title;
-    name.append(a);
-  } else {
-    name.textContent = r.title;
-  }
-  const battery = r.battery && r.battery.percent != null ? `${r.battery.percent.toFixed(0)} %` : '—';
-  const position = r.position ? `${r.position.lat.toFixed(6)}, ${r.position.lng.toFixed(6)}` : '—';
-  tr.append(name, cell(r.heard), cell(r.link), cell(r.mode || '—'), cell(battery), cell(estopText(r)),
-            cell(position), cell((r.alerts || []).join('; ')));
-  return tr;
-}
+document.getElementById('hub-table').addEventListener('click', (e) => {
+  const open = e.target.closest('button.hub-history-open');
+  if (open) history.open(open.dataset.robot);
+});
 
 function showStop(stop) {
   if (!stop) return;
@@ -53,13 +33,24 @@ function showStop(stop) {
   lastStop.replaceChildren(p, ul);
 }
 
+function showForgotten(list) {
+  if (!list || !list.length) return;
+  forgotten.replaceChildren(...list.map((f) => {
+    const li = document.createElement('li');
+    li.dataset.robot = f.name;
+    li.textContent = `${f.name}, ${new Date(f.at * 1000).toLocaleString()}`;
+    return li;
+  }));
+}
+
 async function refresh() {
   if (document.hidden) return;
   try {
     const state = await api('GET', '/api/robots');
-    table.replaceChildren(...state.robots.map(row));
+    table.render(state.robots);
     if (fleetMap) fleetMap.render(state.robots);
     showStop(state.last_stop);
+    showForgotten(state.forgotten);
   } catch {
     // The next second tries again; the table keeps what it last showed.
   }
@@ -76,9 +67,11 @@ button.addEventListener('click', async () => {
   }
 });
 
+const initial = JSON.parse(document.getElementById('hub-state').textContent).robots;
+table.render(initial);
 const fleetMap = createFleetMap(document.getElementById('hub-map'), document.getElementById('hub-map-note'));
 if (fleetMap) {
   window.roverFleetMap = fleetMap.map;  // for the browser tests and the curious operator's console
-  fleetMap.render(JSON.parse(document.getElementById('hub-state').textContent).robots);
+  fleetMap.render(initial);
 }
 setInterval(refresh, 1000);
