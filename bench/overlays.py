@@ -6,7 +6,10 @@ viewer (publisher's CLOCK_MONOTONIC stamp -> the frame's arrival in the viewer's
 scan and costmap events each viewer got a second, and their sizes on the wire, once with the
 overlays and once with no scan or costmap subscribed (the baseline the overlays add to).
 
-    .venv/bin/python bench/overlays.py [--seconds 10] [--clients 10] [--browser]
+    .venv/bin/python bench/overlays.py [--seconds 10] [--clients 10] [--browser] [--tf]
+
+--tf has the publisher send TF and the scan placed through it (one lookup a scan) instead of
+AMCL's pose and the configured laser offset.
 
 --browser also opens the LiveMap page in Chromium (Playwright, /usr/bin/chromium) during the run
 with the overlays on, and prints the page's frames a second (requestAnimationFrame callbacks),
@@ -61,7 +64,7 @@ def watch_page(url: str, seconds: float) -> dict:
             browser.close()
 
 
-def run(clients: int, seconds: float, overlays: bool, browser: bool = False) -> dict:
+def run(clients: int, seconds: float, overlays: bool, browser: bool = False, tf: bool = False) -> dict:
     settings = {} if overlays else {"ROVER_WEB_SCAN_TOPIC": "", "ROVER_WEB_COSTMAP_TOPICS": ""}
     env = ros_env(**settings)
     server = Server(env)
@@ -70,15 +73,19 @@ def run(clients: int, seconds: float, overlays: bool, browser: bool = False) -> 
     try:
         fleet.poll(0.5, lambda *a: None)  # the snapshots
         # With the page to watch after the viewers' run, the publisher goes on for it too.
-        pub = start_peer("overlay_publisher.py", env, "--seconds", str(seconds + (25 if browser else 2)))
+        pub = start_peer("overlay_publisher.py", env, "--seconds", str(seconds + (25 if browser else 2)),
+                         *(["--tf"] if tf else []))
         fleet.poll(1.0, lambda *a: None)  # discovery and the first grid, not measured
         ages = {"scan": [], "costmap": []}
         sizes = {"scan": [], "costmap": []}
+        placed: dict[str, int] = {}
 
         def on_event(t_woken, t_arrived, name, data):
             if name == "scan" and data.get("stamp"):
                 ages["scan"].append(t_arrived - data["stamp"])
                 sizes["scan"].append(len(data["points"]) // 2)
+                how = data.get("placed_by", "configured")  # the scan before TF had no placed_by
+                placed[how] = placed.get(how, 0) + 1
             elif name == "costmap":
                 for layer in data["costmaps"]:
                     ages["costmap"].append(t_arrived - layer["stamp"])
@@ -88,8 +95,9 @@ def run(clients: int, seconds: float, overlays: bool, browser: bool = False) -> 
         fleet.poll(seconds, on_event)
         cpu1, t1 = server.cpu_seconds(), time.monotonic()
         page = watch_page(server.url, min(seconds, 5.0)) if browser else None
-        return {"page": page, "clients": clients, "overlays": overlays, "cpu_pct": 100 * (cpu1 - cpu0) / (t1 - t0),
-                "seconds": t1 - t0, "ages": ages, "sizes": sizes, "bytes": fleet.bytes_received,
+        return {"page": page, "clients": clients, "overlays": overlays, "tf": tf,
+                "cpu_pct": 100 * (cpu1 - cpu0) / (t1 - t0),
+                "seconds": t1 - t0, "ages": ages, "sizes": sizes, "placed": placed, "bytes": fleet.bytes_received,
                 "rss_mb": server.rss_mb()}
     finally:
         if pub is not None:
@@ -99,9 +107,10 @@ def run(clients: int, seconds: float, overlays: bool, browser: bool = False) -> 
 
 
 def report(r: dict) -> None:
-    label = "overlays on " if r["overlays"] else "overlays off"
+    label = ("overlays on " + ("(TF)" if r.get("tf") else "")) if r["overlays"] else "overlays off"
     print(f"{label}: {r['clients']} viewers, server CPU {r['cpu_pct']:.1f}% of a core, RSS {r['rss_mb']:.0f} MB, "
-          f"{r['bytes'] / r['seconds'] / 1e3 / r['clients']:.1f} kB/s per viewer")
+          f"{r['bytes'] / r['seconds'] / 1e3 / r['clients']:.1f} kB/s per viewer"
+          + (f"; scans placed by {r['placed']}" if r.get("placed") else ""))
     for name in ("scan", "costmap"):
         ages = [a * 1000 for a in r["ages"][name]]
         if not ages:
@@ -123,10 +132,11 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=10.0)
     parser.add_argument("--clients", type=int, default=10)
     parser.add_argument("--browser", action="store_true", help="also measure the page in Chromium")
+    parser.add_argument("--tf", action="store_true", help="place the scan through TF (the publisher sends it)")
     args = parser.parse_args()
     print(machine())
     for overlays in (False, True):
-        result = run(args.clients, args.seconds, overlays, browser=args.browser and overlays)
+        result = run(args.clients, args.seconds, overlays, browser=args.browser and overlays, tf=args.tf)
         report(result)
 
 

@@ -1,6 +1,7 @@
 """LiveMap: floorplans from map_files, the live robot pose, its goal and plan, click-to-goal.
 
-ROS: subscribes /amcl_pose (transient local), /goal_pose, /plan and optionally an OccupancyGrid
+ROS: subscribes /amcl_pose (transient local; without it the pose is TF's map -> base_link, looked
+up on a tick: service.py), /goal_pose, /plan (placed through TF when in another frame) and optionally an OccupancyGrid
 (/map, transient local) drawn into a map named "live map"; publishes goals on /goal_pose and the
 operator's initial pose on /initialpose.
 SSE: `pose` (at most LIVEMAP_POSE_MAX_HZ), `goal`, `plan` (at most 5 Hz), `live_map` (new grid).
@@ -47,3 +48,5 @@ def _init_robot(rover: Rover) -> None:
     rover.add_panel(30, "panels/livemap.html", "Live map", channels=("pose",))
     rover.add_nav("Live map", "/livemap")
     rover.every(STALE_CHECK_S, service.check_staleness, name="livemap-staleness")
+    if service.placer.buffer is not None:
+        rover.every(service.tf_pose_period_s, service.pose_from_tf, name="livemap-tf-pose")

@@ -55,9 +55,10 @@ def initial_pose_message(x: float, y: float, yaw: float, covariance, frame_id: s
     return msg
 
 
-def path_points(msg) -> tuple[str, list[tuple[float, float]]]:
-    """(frame_id, [(x, y), ...]) of a nav_msgs/Path."""
-    return msg.header.frame_id, [(p.pose.position.x, p.pose.position.y) for p in msg.poses]
+def path_points(msg) -> tuple[str, list[tuple[float, float]], float]:
+    """(frame_id, [(x, y), ...], stamp seconds) of a nav_msgs/Path."""
+    return (msg.header.frame_id, [(p.pose.position.x, p.pose.position.y) for p in msg.poses],
+            stamp_to_float(msg.header.stamp))
 
 
 def occupancy_grid(msg) -> tuple[dict, np.ndarray]:

@@ -1,15 +1,23 @@
-"""LiveMap's per-app object: the maps, the robot's track and the goal publisher of one app."""
+"""LiveMap's per-app object: the maps, the robot's track and the goal publisher of one app.
+
+The robot's pose is AMCL's (`/amcl_pose`) while AMCL speaks; with no AMCL pose for AMCL_QUIET_S it
+is TF's map -> base_link (ROVER_WEB_MAP_FRAME, ROVER_WEB_BASE_FRAME), looked up once per tick, so
+a robot localised by SLAM Toolbox, Cartographer or robot_localization appears too. The plan is
+placed through TF when it is in another frame than the map. Each says which it used (`placed_by`).
+"""
 
 from __future__ import annotations
 
 import logging
 import math
 import threading
+import time
 from typing import Any
 
 from rover_web.config import ConfigError
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
+from rover_web.placement import MAP, TF, MapPlacer, Unplaceable, tf_buffer
 
 from . import msgs
 from .geometry import MapGeometry, wrap_angle
@@ -24,6 +32,9 @@ LIVE_MAP_NAME = "live map"
 PLAN_MAX_HZ = 5.0
 LIVE_MAP_MAX_HZ = 1.0
 STALE_CHECK_S = 0.2
+AMCL_QUIET_S = 2.0  # AMCL's pose this old (or none): the robot is placed by TF's map -> base_link
+TF_POSE_MIN_PERIOD_S = 0.1  # the robot from TF at most 10 times a second: a loop's wake-ups cost even idle
+UNPLACED = "unplaced"  # a plan in a frame TF does not know: drawn as given (there is no fallback for it)
 
 
 class OutsideMap(ValueError):
@@ -82,6 +93,14 @@ class LiveMapService:
         self.initial_pose_topic = config["ROVER_WEB_INITIAL_POSE_TOPIC"]
         self._goal_lock = threading.Lock()
         self._was_stale = True  # no pose yet counts as stale: nothing to announce
+        self.placer = MapPlacer(tf_buffer(rover) if hasattr(rover, "feature") else None,
+                                config.get("ROVER_WEB_MAP_FRAME", "map"))
+        self.base_frame = config.get("ROVER_WEB_BASE_FRAME", "base_link")
+        self.tf_pose_period_s = max(TF_POSE_MIN_PERIOD_S, 1.0 / self.pose_max_hz)
+        self._amcl_at = -math.inf  # monotonic time of AMCL's latest pose
+        self._tf_stamp: int | None = None  # of the latest map -> base_link taken as the pose
+        self.pose_placed_by: str | None = None  # "amcl" or "tf"
+        self.plan_placed_by: str | None = None
 
     # --- maps ---
 
@@ -112,13 +131,33 @@ class LiveMapService:
 
     # --- ROS input ---
 
-    def on_pose(self, values) -> None:
+    def on_pose(self, values, placed_by: str = "amcl") -> None:
         x, y, yaw, frame_id, stamp = values
         pose = Pose2D(x, y, wrap_angle(yaw) if math.isfinite(yaw) else yaw, frame_id, stamp)
         if not pose.finite:
             return  # a NaN pose is not a place on the map
+        if placed_by == "amcl":
+            self._amcl_at = time.monotonic()
+        self.pose_placed_by = placed_by
         self.track.set_pose(pose)
-        self.rover.hub.publish_throttled("pose", pose_payload(pose, self.maps()), self.pose_max_hz)
+        self.rover.hub.publish_throttled("pose", {**pose_payload(pose, self.maps()), "placed_by": placed_by},
+                                         self.pose_max_hz)
+
+    def pose_from_tf(self) -> None:
+        """One tick: with AMCL quiet, the robot's pose is map -> base_link from TF (one lookup)."""
+        buffer = self.placer.buffer
+        if buffer is None or time.monotonic() - self._amcl_at < AMCL_QUIET_S:
+            return
+        from rover_web.tf.buffer import TfError
+
+        try:
+            t = buffer.lookup(self.placer.map_frame, self.base_frame, None)
+        except TfError:
+            return  # no tree from map to the base (yet): no pose, and the old one goes stale
+        if t.stamp_ns == self._tf_stamp and t.stamp_ns != 0:
+            return  # nothing new: a silent TF must go stale, not look fresh
+        self._tf_stamp = t.stamp_ns
+        self.on_pose((t.translation[0], t.translation[1], t.yaw, self.placer.map_frame, t.stamp_ns / 1e9), "tf")
 
     def on_goal(self, values) -> None:
         x, y, yaw, frame_id, stamp = values
@@ -126,9 +165,21 @@ class LiveMapService:
         if goal.finite and self.track.set_goal(goal):
             self.rover.hub.publish("goal", goal_payload(goal, self.maps()))
 
-    def on_plan(self, frame_id: str, points: list[tuple[float, float]]) -> None:
+    def on_plan(self, frame_id: str, points: list[tuple[float, float]], stamp: float = 0.0) -> None:
         points = [(x, y) for x, y in points if math.isfinite(x) and math.isfinite(y)]
-        payload = plan_payload(frame_id, points, self.plan_max_points)
+        placed_by = MAP
+        if points and frame_id.lstrip("/") not in (self.placer.map_frame, "", self.goal_frame_id):
+            try:
+                placement = self.placer.lookup(frame_id, stamp)
+            except Unplaceable:
+                placement = None  # a plan out of TF's reach is drawn as given, and says so
+            if placement is not None:
+                xs, ys, _ = placement.apply_many([p[0] for p in points], [p[1] for p in points], None)
+                points, placed_by = list(zip(xs.tolist(), ys.tolist(), strict=True)), TF
+            else:
+                placed_by = UNPLACED
+        self.plan_placed_by = placed_by
+        payload = {**plan_payload(frame_id, points, self.plan_max_points), "placed_by": placed_by}
         self.track.set_plan(payload)
         self.rover.hub.publish_throttled("plan", payload, PLAN_MAX_HZ)
 

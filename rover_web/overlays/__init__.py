@@ -2,8 +2,9 @@
 
 ROS: subscribes a sensor_msgs/LaserScan (ROVER_WEB_SCAN_TOPIC), nav_msgs/OccupancyGrid costmaps
 (ROVER_WEB_COSTMAP_TOPICS), a visualization_msgs/MarkerArray (ROVER_WEB_MARKERS_TOPIC), a
-geometry_msgs/PolygonStamped footprint (ROVER_WEB_FOOTPRINT_TOPIC) and the AMCL pose (for the pose
-a scan was taken at, and the recent path).
+geometry_msgs/PolygonStamped footprint (ROVER_WEB_FOOTPRINT_TOPIC), each placed in the map through
+TF (rover_web/placement.py), and the AMCL pose (else TF's map -> base_link: the recent path, and the
+fallback's robot when TF does not know a message's frame).
 SSE: `scan`, `costmap`, `markers`, `footprint`, each rate-limited. HTTP: GET /api/overlays.
 Modules: service (the per-app object), scan (thinning), costmap (encoding), markers (the set),
 poses (pose history), counts, msgs, routes.
@@ -18,7 +19,7 @@ from rover_web.core.state import Rover
 
 from . import bounds, msgs, routes
 from .bounds import bounded
-from .service import CHANNELS, COSTMAP_CHECK_S, OverlayService
+from .service import CHANNELS, COSTMAP_CHECK_S, TF_POSE_S, OverlayService
 
 MARKER_EXPIRY_S = 0.5
 
@@ -77,5 +78,7 @@ def _init_robot(rover: Rover) -> None:
                           share=True, track=not runtime.tracks(config["ROVER_WEB_ODOM_TOPIC"]))
     if service.costmap_topics:
         rover.every(COSTMAP_CHECK_S, service.encode_costmaps, name="overlays-costmap")
+    if service.placer.buffer is not None:
+        rover.every(TF_POSE_S, service.pose_from_tf, name="overlays-tf-pose")
     if service.markers_topic:
         rover.every(MARKER_EXPIRY_S, service.expire_markers, name="overlays-marker-expiry")

@@ -14,15 +14,18 @@ class LayerCounts:
         self.sent = 0
         self.skipped: Counter[str] = Counter()
         self.dropped = 0  # items left out of messages that were drawn (a scan's beams with no return)
+        self.placed_by: str | None = None  # how the latest drawn message was placed: tf, configured or map
         self._lock = threading.Lock()
 
     def receive(self) -> None:
         with self._lock:
             self.received += 1
 
-    def send(self) -> None:
+    def send(self, placed_by: str | None = None) -> None:
         with self._lock:
             self.sent += 1
+            if placed_by is not None:
+                self.placed_by = placed_by
 
     def skip(self, reason: str, n: int = 1) -> None:
         with self._lock:
@@ -36,4 +39,4 @@ class LayerCounts:
         with self._lock:
             return {"topics": list(self.topics), "received": self.received, "converted": self.sent,
                     "skipped": sum(self.skipped.values()), "skipped_by_reason": dict(self.skipped),
-                    "dropped_items": self.dropped}
+                    "dropped_items": self.dropped, "placed_by": self.placed_by}

@@ -53,7 +53,7 @@ def markers(msg, most: int = MARKERS_MAX_COUNT) -> list[dict]:
         p = m.pose
         c = m.color
         out.append({"ns": m.ns[:NS_MAX], "id": int(m.id), "type": int(m.type), "action": int(m.action),
-                    "frame_id": m.header.frame_id[:FRAME_ID_MAX],
+                    "frame_id": m.header.frame_id[:FRAME_ID_MAX], "stamp": stamp_to_float(m.header.stamp),
                     "pose": (p.position.x, p.position.y, _yaw(p.orientation)),
                     "scale": (m.scale.x, m.scale.y, m.scale.z), "color": (c.r, c.g, c.b, c.a),
                     "points": [(q.x, q.y) for q in m.points],

@@ -5,6 +5,11 @@ draws, and each channel is rate-limited on the server (the page could not draw m
 Costmaps are the expensive one: a new grid is only kept, and a loop off the executor encodes the
 newest grid of each topic, at most ROVER_WEB_COSTMAP_MAX_HZ times a second. Messages that cannot be drawn are
 skipped and counted by reason (`GET /api/overlays`), never raised.
+
+Each message is placed in the map frame through TF (map <- its header's frame at its stamp, one
+lookup per message: rover_web/placement.py) when TF knows its frame; otherwise with the fallback
+it had before TF: the configured laser offset and AMCL's pose, map -> odom rebuilt from two poses
+(frames.py). Every layer says which placed its latest message (`placed_by`).
 """
 
 from __future__ import annotations
@@ -16,15 +21,18 @@ import threading
 import time
 from typing import Any
 
+import numpy as np
+
 from rover_web.config import ConfigError
 from rover_web.core.state import Rover
+from rover_web.placement import CONFIGURED, IDENTITY, MAP, TF, MapPlacer, Planar, Unplaceable, heading, tf_buffer
 from rover_web.ros import cdr
 from rover_web.ros.convert import yaw_from_quaternion
 
 from . import costmap, scan
 from .counts import LayerCounts
 from .frames import OdomInMap, compose
-from .markers import MAP_FRAMES, ROBOT_FRAMES, BadMarker, MarkerSet
+from .markers import MAP_FRAMES, ROBOT_FRAMES, BadMarker, MarkerSet, robot_frames
 from .poses import PoseHistory
 
 log = logging.getLogger(__name__)
@@ -33,6 +41,8 @@ FOOTPRINT_MAX_HZ = 5.0
 COSTMAP_CHECK_S = 0.05  # how often the encoding loop looks for a new grid: the most it adds to a grid's age
 FOOTPRINT_MAX_POINTS = 200
 CHANNELS = ("scan", "costmap", "markers", "footprint")
+AMCL_QUIET_S = 2.0  # no AMCL pose this long: the robot's pose history is fed from TF's map -> base_link
+TF_POSE_S = 0.2  # how often then (the path keeps a point per 5 cm: 5 a second is plenty)
 
 
 def laser_offset(config: dict[str, Any]) -> tuple[float, float, float]:
@@ -63,6 +73,12 @@ class OverlayService:
         self.costmap_max_cells = config["ROVER_WEB_COSTMAP_MAX_CELLS"]
         self.markers_max_hz = config["ROVER_WEB_MARKERS_MAX_HZ"]
         self.map_frames = {*MAP_FRAMES, config["ROVER_WEB_GOAL_FRAME_ID"]}
+        self.placer = MapPlacer(tf_buffer(rover) if hasattr(rover, "feature") else None,
+                                config.get("ROVER_WEB_MAP_FRAME", "map"))
+        self.map_frames.add(self.placer.map_frame)
+        self.base_frame = config.get("ROVER_WEB_BASE_FRAME", "base_link")
+        self._amcl_at = -math.inf
+        self._tf_stamp: int | None = None
         self.poses = PoseHistory(keep_s=config["ROVER_WEB_LIVEMAP_TRAIL_S"])
         self.odom_frame = OdomInMap()
         self.counts = {
@@ -75,6 +91,8 @@ class OverlayService:
         self._pending: dict[str, costmap.Grid] = {}  # newest grid per topic, not yet encoded
         self._encoded: dict[str, dict] = {}  # topic -> its part of the costmap channel
         self._grid_seq = 0
+        self._placed_lock = threading.Lock()
+        self._placed_by: dict[str, str] = {}  # costmap topic -> how its newest grid was placed
         self._next_encode = 0.0  # monotonic time the next encoding may start
         self._markers = MarkerSet(max_points=config["ROVER_WEB_MARKERS_MAX_POINTS"])
         self._markers_lock = threading.Lock()
@@ -83,8 +101,24 @@ class OverlayService:
 
     def on_pose(self, stamp: float, x: float, y: float, yaw: float) -> None:
         if all(map(math.isfinite, (stamp, x, y, yaw))):
+            self._amcl_at = time.monotonic()
             self.poses.add(stamp, x, y, yaw)
             self.odom_frame.on_map_pose(stamp, (x, y, yaw))
+
+    def pose_from_tf(self) -> None:
+        """One tick: with AMCL quiet, the recent path (and the fallback's robot) from TF's map -> base_link."""
+        buffer = self.placer.buffer
+        if buffer is None or time.monotonic() - self._amcl_at < AMCL_QUIET_S:
+            return
+        from rover_web.tf.buffer import TfError
+
+        try:
+            t = buffer.lookup(self.placer.map_frame, self.base_frame, None)
+        except TfError:
+            return
+        if t.stamp_ns != self._tf_stamp:
+            self._tf_stamp = t.stamp_ns
+            self.poses.add(t.stamp_ns / 1e9, t.translation[0], t.translation[1], t.yaw)
 
     def on_odom(self, raw: bytes) -> None:
         """The odometry's pose, for placing grids and footprints given in its frame (frames.py)."""
@@ -106,21 +140,40 @@ class OverlayService:
             counts.skip(str(exc))
             return
         frame = value.frame_id.lstrip("/")
+        placement = None
         if frame in self.map_frames:
-            robot, laser = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)  # a scan already in the map frame (a simulator's)
+            placed_by = MAP  # a scan already in the map frame
         else:
-            robot, laser = self.poses.at(value.stamp), self.laser
-            if robot is None:
-                counts.skip("no_pose")
+            try:
+                placement = self.placer.lookup(frame, value.stamp)
+            except Unplaceable as exc:
+                counts.skip(str(exc))
                 return
-        angles, ranges, invalid = scan.thin(value, self.scan_bins)
+            placed_by = TF if placement is not None else CONFIGURED
+            if placement is None:
+                robot = self.poses.at(value.stamp)
+                if robot is None:
+                    counts.skip("no_pose")
+                    return
+                placement = Planar(*robot).compose_2d(self.laser)
+        thinned = scan.thin_both(value, self.scan_bins)
         # NaN, inf and out-of-range beams are no return, as RViz shows them: counted, not drawn. A
         # scan with none left is still sent, empty: the robot sees nothing in range (an open field,
         # a laser inside a wall), and the page must not keep showing the last scan's points.
-        counts.drop(invalid)
-        points = scan.to_map(angles, ranges, robot, laser)
-        counts.send()
-        self.hub.publish_throttled("scan", scan.payload(self.scan_topic, value, robot, points), self.scan_max_hz)
+        counts.drop(thinned.invalid)
+        placement = placement or IDENTITY
+        points = self._place_returns(placement, thinned.angles, thinned.ranges)
+        far = self._place_returns(placement, thinned.far_angles, thinned.far_ranges)
+        counts.send(placed_by)
+        self.hub.publish_throttled("scan", scan.payload(self.scan_topic, value, heading(placement, 0.0, 0.0, 0.0),
+                                                        points, far, placed_by), self.scan_max_hz)
+
+    @staticmethod
+    def _place_returns(placement, angles, ranges):
+        """Returns in the laser's frame, placed in 3D (a tilted laser too), as (N, 2) map points."""
+        xs, ys = scan.in_sensor_frame(angles, ranges)
+        mx, my, _ = placement.apply_many(xs, ys, None)
+        return np.column_stack((mx, my))
 
     # --- costmaps ---
 
@@ -132,12 +185,24 @@ class OverlayService:
         except costmap.BadGrid as exc:
             counts.skip(str(exc))
             return
+        placed_by = MAP
         if grid.frame_id.lstrip("/") not in self.map_frames:
-            map_t_odom = self.odom_frame.transform(grid.frame_id)
-            if map_t_odom is None:
-                counts.skip("unknown_frame")
+            try:
+                placement = self.placer.lookup(grid.frame_id, grid.stamp)
+            except Unplaceable as exc:
+                counts.skip(str(exc))
                 return
-            grid = dataclasses.replace(grid, frame_id="map", origin=compose(map_t_odom, grid.origin))
+            if placement is not None:
+                placed_by, origin = TF, heading(placement, *grid.origin)
+            else:
+                map_t_odom = self.odom_frame.transform(grid.frame_id)
+                if map_t_odom is None:
+                    counts.skip("unknown_frame")
+                    return
+                placed_by, origin = CONFIGURED, compose(map_t_odom, grid.origin)
+            grid = dataclasses.replace(grid, frame_id="map", origin=origin)
+        with self._placed_lock:
+            self._placed_by[topic] = placed_by
         with self._grids_lock:
             self._pending[topic] = grid  # the encoding loop takes the newest
 
@@ -153,7 +218,9 @@ class OverlayService:
         for topic, grid in pending.items():
             self._grid_seq += 1
             encoded = costmap.encode(grid, topic, self._grid_seq, self.costmap_max_side)
-            self.counts["costmap"].send()
+            with self._placed_lock:
+                encoded["placed_by"] = self._placed_by.get(topic, MAP)
+            self.counts["costmap"].send(encoded["placed_by"])
             with self._grids_lock:
                 self._encoded[topic] = encoded
         # Only the grids that changed carry their cells: a global costmap that changes once a minute
@@ -182,15 +249,37 @@ class OverlayService:
             return
         robot = self.poses.latest()
         now = time.monotonic()
+        placed: list[str] = []
+        lookups: dict[tuple[str, float], tuple] = {}  # one lookup per frame and stamp of the array
+
+        def place(frame: str, stamp: float):
+            key = (frame, stamp)
+            if key not in lookups:
+                lookups[key] = self._place_marker(frame, stamp, robot)
+            placement, how = lookups[key]
+            placed.append(how)
+            return placement, how
+
         with self._markers_lock:
             for marker in markers:
                 try:
-                    self._markers.apply(marker, robot, now)
+                    self._markers.apply(marker, place, now)
                 except BadMarker as exc:
                     counts.skip(str(exc))
             payload = self._markers.payload(self.markers_topic)
-        counts.send()
+        counts.send(TF if TF in placed else (placed[-1] if placed else None))
         self.hub.publish_throttled("markers", payload, self.markers_max_hz)
+
+    def _place_marker(self, frame: str, stamp: float, robot):
+        if frame in self.map_frames:
+            return IDENTITY, MAP
+        try:
+            placement = self.placer.lookup(frame, stamp)
+        except Unplaceable as exc:
+            raise BadMarker(str(exc)) from None
+        if placement is not None:
+            return placement, TF
+        return robot_frames(robot)(frame, stamp)
 
     def expire_markers(self) -> None:
         with self._markers_lock:
@@ -211,8 +300,17 @@ class OverlayService:
             counts.skip("not_finite")
             return
         frame = frame_id.lstrip("/")
+        try:
+            placement = None if frame in self.map_frames else self.placer.lookup(frame, stamp)
+        except Unplaceable as exc:
+            counts.skip(str(exc))
+            return
+        placed_by = CONFIGURED
         if frame in self.map_frames:
-            polygon = points
+            polygon, placed_by = points, MAP
+        elif placement is not None:
+            xs, ys, _ = placement.apply_many([p[0] for p in points], [p[1] for p in points], None)
+            polygon, placed_by = list(zip(xs.tolist(), ys.tolist(), strict=True)), TF
         elif frame in ROBOT_FRAMES:
             robot = self.poses.at(stamp)
             if robot is None:
@@ -226,9 +324,9 @@ class OverlayService:
         else:
             counts.skip("unknown_frame")
             return
-        counts.send()
+        counts.send(placed_by)
         self.hub.publish_throttled("footprint", {
-            "topic": self.footprint_topic, "frame_id": frame_id, "stamp": stamp,
+            "topic": self.footprint_topic, "frame_id": frame_id, "stamp": stamp, "placed_by": placed_by,
             "polygon": [[round(x, 3), round(y, 3)] for x, y in polygon]}, FOOTPRINT_MAX_HZ)
 
     # --- what the page and the API read ---
@@ -242,5 +340,8 @@ class OverlayService:
                 {"name": "scan", "label": "Laser scan", "topics": self.counts["scan"].topics}]
 
     def summary(self) -> dict:
+        with self._placed_lock:
+            costmaps = dict(self._placed_by)
         return {"layers": {name: c.snapshot() for name, c in self.counts.items()},
-                "trail": self.poses.path(), "laser_offset": list(self.laser)}
+                "trail": self.poses.path(), "laser_offset": list(self.laser),
+                "tf": self.placer.buffer is not None, "costmaps_placed_by": costmaps}

@@ -58,7 +58,7 @@ def _pose(read):
 
 
 def _plan(msg) -> dict:
-    frame_id, points = path_points(msg)
+    frame_id, points, _stamp = path_points(msg)
     points = [p for p in points if math.isfinite(p[0]) and math.isfinite(p[1])]
     return {"frame_id": frame_id, "length": len(points),
             "points": [list(p) for p in _thin(points, MAX_PLAN_POINTS)]}

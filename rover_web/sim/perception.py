@@ -1,9 +1,11 @@
 """The simulated rover's perception topics, so the demo's LiveMap shows every overlay.
 
-On the rover's node: `scan` (sensor_msgs/LaserScan ray-cast from the floorplan, frame `base_scan`
-at the robot's centre, stamped like its amcl_pose), `global_costmap/costmap` (the whole floorplan
-inflated, transient local, every 10 s), `local_costmap/costmap` (a 6 m window around the robot,
-1 Hz), `global_costmap/published_footprint` (its square footprint in the map frame, 5 Hz) and
+On the rover's node: `scan` (sensor_msgs/LaserScan ray-cast from the floorplan from the laser's
+mount, frame `base_scan`, upside down, turned and off centre (frames.py), stamped like the odometry
+whose pose it was cast from), `global_costmap/costmap` (the whole floorplan inflated, in `map`,
+transient local, every 10 s), `local_costmap/costmap` (a 6 m window around the robot in `odom`, as
+Nav2's rolling window is, 1 Hz), `global_costmap/published_footprint` (its square footprint in
+`base_link`, 5 Hz) and
 `visualization_marker_array` (its map's waypoints as spheres and labels, the route through them
 as a line, and a heading arrow in `base_link`, 1 Hz). All names are relative: `--robots` puts
 them under each robot's namespace.
@@ -22,6 +24,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 from rover_web.ros import qos
 
+from .frames import BASE_FRAME, LASER, ODOM_FRAME, beam_directions, compose, invert, laser_origin
 from .sensors import Floorplan, footprint, window
 
 RANGE_MAX_M = 12.0
@@ -58,33 +61,38 @@ class Perception:
 
     def publish_scan(self) -> None:
         d = self.node.drive
-        msg = self._header(self._scan_class(), "base_scan")
+        msg = self._scan_class()
+        msg.header.stamp = self.node.last_stamp  # the odometry (and TF) of the pose it is cast from
+        msg.header.frame_id = LASER.frame
         msg.angle_min, msg.angle_increment = float(self.angles[0]), float(self.angles[1] - self.angles[0])
         msg.angle_max = float(self.angles[-1])
         msg.range_min, msg.range_max = 0.05, RANGE_MAX_M
-        msg.ranges = self.plan.raycast(d.x, d.y, d.yaw, self.angles, RANGE_MAX_M).tolist()
+        x, y, heading = laser_origin((d.x, d.y, d.yaw))
+        msg.ranges = self.plan.raycast(x, y, heading, beam_directions(self.angles), RANGE_MAX_M).tolist()
         self.scan_pub.publish(msg)
 
-    def _grid(self, cells: np.ndarray, origin_x: float, origin_y: float) -> OccupancyGrid:
-        msg = self._header(OccupancyGrid(), "map")
+    def _grid(self, cells: np.ndarray, origin, frame_id: str = "map") -> OccupancyGrid:
+        msg = self._header(OccupancyGrid(), frame_id)
         msg.info.resolution = self.plan.resolution
         msg.info.height, msg.info.width = cells.shape
-        msg.info.origin.position.x, msg.info.origin.position.y = origin_x, origin_y
-        msg.info.origin.orientation.w = 1.0
+        msg.info.origin.position.x, msg.info.origin.position.y = float(origin[0]), float(origin[1])
+        msg.info.origin.orientation.z, msg.info.origin.orientation.w = math.sin(origin[2] / 2), math.cos(origin[2] / 2)
         msg.data = cells.ravel().tobytes()
         return msg
 
     def publish_global(self) -> None:
-        self.global_pub.publish(self._grid(self.costs, self.plan.origin_x, self.plan.origin_y))
+        self.global_pub.publish(self._grid(self.costs, (self.plan.origin_x, self.plan.origin_y, 0.0)))
 
     def publish_local(self) -> None:
         d = self.node.drive
-        self.local_pub.publish(self._grid(*window(self.costs, self.plan, d.x, d.y, LOCAL_SIZE_M)))
+        cells, ox, oy = window(self.costs, self.plan, d.x, d.y, LOCAL_SIZE_M)
+        # The window is cut from the map-aligned floorplan; in odom its origin is turned by odom's yaw.
+        origin = compose(invert(self.node.localisation.map_t_odom), (ox, oy, 0.0))
+        self.local_pub.publish(self._grid(cells, origin, ODOM_FRAME))
 
     def publish_footprint(self) -> None:
-        d = self.node.drive
-        msg = self._header(PolygonStamped(), "map")
-        msg.polygon.points = [Point32(x=float(x), y=float(y)) for x, y in footprint(d.x, d.y, d.yaw, FOOTPRINT_HALF_M)]
+        msg = self._header(PolygonStamped(), BASE_FRAME)
+        msg.polygon.points = [Point32(x=float(x), y=float(y)) for x, y in footprint(0.0, 0.0, 0.0, FOOTPRINT_HALF_M)]
         self.footprint_pub.publish(msg)
 
     def publish_markers(self) -> None:

@@ -1,4 +1,5 @@
-"""A simulated differential-drive rover: integrates cmd_vel, publishes odom, amcl_pose and fix.
+"""A simulated differential-drive rover: integrates cmd_vel, publishes odom, amcl_pose, fix and its
+frames on tf and tf_static (frames.py: map -> odom -> base_link, and its sensors' mounts).
 
 Topic names are relative, so in the root namespace they are /cmd_vel, /odom, ... and in a robot's
 namespace (`--robots`) /boat/cmd_vel, /boat/odom, ...
@@ -8,7 +9,8 @@ map pose laid on a local tangent plane around a configurable origin (by default 
 Benderson Park, Sarasota, FL, where RobotX is held).
 
 It starts on the first floorplan of map_files/all_maps.json (at that map's first waypoint), jumps
-to an initial pose on /initialpose (as AMCL would re-localise; it has no odometry drift), and
+to an initial pose on /initialpose (as AMCL would re-localise: map -> odom moves, odometry's
+position stays continuous; it has no odometry drift), and
 drives itself to a goal received on /goal_pose (frame `map`) with a simple turn-and-drive
 controller, publishing a straight-line /plan while it goes, and stops there. The operator always
 wins: any /cmd_vel message, a stop included, cancels the goal, as a stop button would on a
@@ -39,6 +41,7 @@ from rover_web.ros import qos
 from rover_web.ros.convert import quaternion_from_yaw, yaw_from_quaternion
 
 from .battery import START_CHARGE, Battery, battery_state
+from .frames import FramePublisher, Localisation
 from .geodesy import enu_to_geodetic
 from .health import HealthModel
 from .mission import MissionDriver
@@ -189,6 +192,11 @@ class RoverSim(Node):
         self.pose_pub = self.create_publisher(PoseWithCovarianceStamped, "amcl_pose", qos.profile("latched"))
         self.fix_pub = self.create_publisher(NavSatFix, "fix", 10)
         self.plan_pub = self.create_publisher(Path, "plan", 1)
+        # Odometry starts in the map's coordinates (map -> odom the identity, as a datum would set
+        # it); an initial pose then moves map -> odom and odometry's position stays continuous (frames.py).
+        self.localisation = Localisation((0.0, 0.0, 0.0))
+        self.frames = FramePublisher(self, self.localisation)
+        self.last_stamp = self.get_clock().now().to_msg()  # of the latest odometry: the pose sensors use
         self.create_subscription(PoseStamped, goal_topic, self._on_goal, 10)
         self.mission = MissionDriver(self)
         # Standing in for AMCL: an operator's initial pose (LiveMap's Set pose) puts the robot there.
@@ -251,6 +259,7 @@ class RoverSim(Node):
             self.get_logger().warning("ignoring an initial pose that is not a finite pose in frame 'map'")
             return
         d = self.drive
+        self.localisation.relocalise((d.x, d.y, d.yaw), (p.x, p.y, yaw))
         d.x, d.y, d.yaw = p.x, p.y, yaw
         self.get_logger().info(f"initial pose set: ({p.x:.2f}, {p.y:.2f}), {math.degrees(yaw):.0f} degrees")
 
@@ -275,19 +284,22 @@ class RoverSim(Node):
             self.plan_pub.publish(self._plan(None))
         self._ticks += 1
         stamp = self.get_clock().now().to_msg()
+        self.last_stamp = stamp
         self.odom_pub.publish(self._odom(stamp))
+        self.frames.publish(stamp, (d.x, d.y, d.yaw))
         if self._ticks % 5 == 0:  # amcl and GPS publish slower than odometry, as on a real robot
             self.pose_pub.publish(self._pose(stamp))
             self.fix_pub.publish(self._fix(stamp))
 
     def _odom(self, stamp) -> Odometry:
         d = self.drive
+        x, y, yaw = self.localisation.odom_pose((d.x, d.y, d.yaw))
         msg = Odometry()
         msg.header.stamp = stamp
         msg.header.frame_id = "odom"
         msg.child_frame_id = "base_link"
-        msg.pose.pose.position.x, msg.pose.pose.position.y = d.x, d.y
-        q = quaternion_from_yaw(d.yaw)
+        msg.pose.pose.position.x, msg.pose.pose.position.y = x, y
+        q = quaternion_from_yaw(yaw)
         o = msg.pose.pose.orientation
         o.x, o.y, o.z, o.w = q
         msg.twist.twist.linear.x = d.linear

@@ -9,7 +9,8 @@ HTTP (routes.py; the rules live in store, geojson and gps):
   GET/POST /api/waypoints/geojson      export / import (replace) as a GeoJSON FeatureCollection
 SSE: `waypoints` (the stored mission, at most 10 Hz, broadcaster.py), `fix` (robot position, fix
 quality, accuracy and track, 5 Hz, from NavSatFix on ROVER_WEB_FIX_TOPIC) and `heading` (compass
-bearing, 10 Hz, from ROVER_WEB_GPS_HEADING_TOPIC; heading.py).
+bearing, 10 Hz, from ROVER_WEB_GPS_HEADING_TOPIC; heading.py). Through TF (mounts.py) the fix is moved
+from the antenna to base_link and an IMU's heading turned by its mount; each says `placed_by`.
 
 Every waypoint added, by either POST, is stored (committed, fsynced) first and then published on
 /waypoints, so an acknowledged waypoint is both on disk and on the wire. Moves, reorders, deletes
@@ -24,7 +25,7 @@ from rover_web.estop import EStopService
 from rover_web.geofence import GeofenceService
 
 from . import broadcaster, routes
-from .msgs import HEADING_TYPES, NAV_SAT_FIX, fix_reading, heading_yaw, odometry_yaw
+from .msgs import HEADING_TYPES, NAV_SAT_FIX, fix_reading, heading_orientation, odometry_yaw
 from .service import FIX_CHANNEL, HEADING_CHANNEL, WaypointsService
 
 
@@ -52,7 +53,8 @@ def _init_robot(rover: Rover) -> None:
                                     track=not rover.runtime.tracks(heading_topic))
         else:
             rover.runtime.subscribe(HEADING_TYPES[kind], heading_topic,
-                                    lambda msg: service.on_heading(heading_yaw(msg, kind)), qos="sensor_data",
+                                    lambda msg: service.on_orientation(*heading_orientation(msg, kind)),
+                                    qos="sensor_data",
                                     track=not rover.runtime.tracks(heading_topic))
         rover.every(min(0.5, config["ROVER_WEB_GPS_HEADING_STALE_S"] / 2), service.check_heading,
                     name="gps-heading-staleness")

@@ -30,6 +30,7 @@ class FixReading:
     lng: float
     alt: float
     horizontal_sigma_m: float | None = None  # from position_covariance when it is known
+    frame_id: str = ""  # the antenna's frame (mounts.py places the robot's centre from it through TF)
 
 
 def distance_m(lng1: float, lat1: float, lng2: float, lat2: float) -> float:

@@ -51,7 +51,7 @@ def fix_reading(msg) -> FixReading:
         if math.isfinite(east) and math.isfinite(north) and east >= 0 and north >= 0:
             sigma = math.sqrt((east + north) / 2)
     return FixReading(status=int(msg.status.status), lat=float(msg.latitude), lng=float(msg.longitude),
-                      alt=float(msg.altitude), horizontal_sigma_m=sigma)
+                      alt=float(msg.altitude), horizontal_sigma_m=sigma, frame_id=msg.header.frame_id)
 
 
 def heading_yaw(msg, kind: str) -> float | None:
@@ -65,6 +65,19 @@ def heading_yaw(msg, kind: str) -> float | None:
     else:
         q = msg.pose.orientation
     return yaw_of_quaternion(float(q.x), float(q.y), float(q.z), float(q.w))
+
+
+def heading_orientation(msg, kind: str) -> tuple[tuple[float, float, float, float] | None, str]:
+    """(orientation x, y, z, w or None, the frame it is the orientation of) of an Imu or PoseStamped:
+    an IMU's is its own frame's (header.frame_id, REP 145), a pose's its header's frame's child,
+    taken as the base (no sensor to correct for)."""
+    if kind == "imu":
+        if msg.orientation_covariance[0] == -1.0:
+            return None, ""
+        q = msg.orientation
+        return (float(q.x), float(q.y), float(q.z), float(q.w)), msg.header.frame_id
+    q = msg.pose.orientation
+    return (float(q.x), float(q.y), float(q.z), float(q.w)), ""
 
 
 def odometry_yaw(raw: bytes) -> float | None:

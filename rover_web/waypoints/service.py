@@ -2,16 +2,20 @@
 
 from __future__ import annotations
 
+import dataclasses
 import logging
+import math
 
 from rover_web.basemap.source import map_view
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
 from rover_web.geofence import GeofenceService, OutsideGeofence
+from rover_web.placement import tf_buffer
 
 from .broadcaster import MissionBroadcaster
 from .gps import FixReading, GpsTrack
-from .heading import Heading
+from .heading import Heading, yaw_of_quaternion
+from .mounts import base_yaw, robot_centre
 from .msgs import FLOAT64_MULTI_ARRAY, mission_message, waypoint_message
 from .store import EmptyMission, Mission, StaleRevision, Waypoint, WaypointStore
 
@@ -43,17 +47,57 @@ class WaypointsService:
         self.heading = Heading(config["ROVER_WEB_GPS_HEADING_TOPIC"], config["ROVER_WEB_GPS_HEADING_OFFSET_DEG"],
                                config["ROVER_WEB_GPS_HEADING_STALE_S"])
         self.broadcaster = MissionBroadcaster(self.store, rover.hub)
+        self.tf = tf_buffer(rover)
+        self.base_frame = config.get("ROVER_WEB_BASE_FRAME", "base_link")
+
+    def _mount(self, frame: str):
+        """TF's sensor <- base_link... as base_link <- frame's transform, or None (no TF, unknown, the base itself)."""
+        frame = frame.lstrip("/")
+        if self.tf is None or not frame or frame == self.base_frame:
+            return None
+        from rover_web.tf.buffer import TfError
+
+        try:
+            return self.tf.lookup(self.base_frame, frame, None)
+        except TfError:
+            return None
 
     def on_fix(self, reading: FixReading) -> None:
-        state = self.track.update(reading)
+        placed_by, offset = "antenna", None
+        mount = self._mount(reading.frame_id)
+        heading = self.heading.state()
+        if mount is not None and heading is not None and not heading["stale"] \
+                and math.isfinite(reading.lat) and math.isfinite(reading.lng):
+            offset = (mount.translation[0], mount.translation[1])
+            yaw_enu = heading["yaw_rad"] + math.radians(self.heading.offset_deg)
+            lat, lng = robot_centre(reading.lat, reading.lng, offset, yaw_enu)
+            reading, placed_by = dataclasses.replace(reading, lat=lat, lng=lng), "tf"
+        state = {**self.track.update(reading), "placed_by": placed_by,
+                 "antenna_offset_m": None if offset is None else [round(v, 3) for v in offset]}
         self.hub.publish_throttled(FIX_CHANNEL, state, FIX_CHANNEL_MAX_HZ)
         if state["fix"]:
             self.geofence.note_position(state["lng"], state["lat"])
 
-    def on_heading(self, yaw_rad: float | None) -> None:
+    def on_heading(self, yaw_rad: float | None, placed_by: str = "message") -> None:
         state = self.heading.update(yaw_rad)
         if state is not None:
-            self.hub.publish_throttled(HEADING_CHANNEL, state, HEADING_CHANNEL_MAX_HZ)
+            self.hub.publish_throttled(HEADING_CHANNEL, {**state, "placed_by": placed_by}, HEADING_CHANNEL_MAX_HZ)
+
+    def on_orientation(self, orientation, frame: str) -> None:
+        """A heading sensor's orientation: its mount on the robot (TF's frame <- base_link) composed in."""
+        if orientation is None:
+            self.on_heading(None)
+            return
+        mount = self._mount(frame)
+        if mount is None:
+            self.on_heading(yaw_of_quaternion(*orientation))
+            return
+        if yaw_of_quaternion(*orientation) is None:
+            self.on_heading(None)
+            return
+        norm = math.sqrt(sum(v * v for v in orientation))
+        q = tuple(v / norm for v in orientation)
+        self.on_heading(base_yaw(q, mount.inverse().rotation), "tf")
 
     def check_heading(self) -> None:
         stale = self.heading.went_stale()

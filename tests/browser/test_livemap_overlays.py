@@ -120,7 +120,7 @@ def test_every_overlay_is_drawn_where_its_coordinates_say_and_each_toggles(live_
     open_map(page, live_server.url)
     s = feed_until_drawn(page, sensing)
     layers = s["layers"]
-    assert layers["scan"] == {"points": 1, "beams": 360}
+    assert layers["scan"] == {"points": 1, "far": 0, "beams": 360, "placed_by": "configured"}  # no TF: the offsets
     # Scan: the one return lies 2 m ahead of the robot at (23, 8), facing +x.
     assert pixel(page, s, 25.0, 8.0) == SCAN_RGB
     # Costmap: the lethal west half is magenta over the floor, the free south-east quarter leaves the

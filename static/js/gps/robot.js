@@ -85,6 +85,11 @@ export function createRobot(out, quality) {
       out.dataset.lng = String(fix.lng);
       out.dataset.lat = String(fix.lat);
       out.textContent = fmtLatLng(fix.lat, fix.lng) + (fix.accuracy_m !== null ? ` ±${fix.accuracy_m} m` : '');
+      // The robot's centre (the antenna's offset taken out through TF), or the antenna as it reported.
+      out.dataset.placed = fix.placed_by || 'antenna';
+      out.title = fix.placed_by === 'tf'
+        ? `base_link, placed by TF from the antenna ${JSON.stringify(fix.antenna_offset_m)} m off it`
+        : 'the antenna\'s own position (no TF for its frame)';
     } else {
       delete out.dataset.lng;
       delete out.dataset.lat;
@@ -112,6 +117,8 @@ export function createRobot(out, quality) {
       if (el) {
         el.textContent = heading.stale ? `— (nothing on ${heading.topic} lately)` : `${Math.round(heading.heading_deg)}°`;
         el.dataset.stale = heading.stale ? 'yes' : 'no';
+        el.dataset.placed = heading.placed_by || 'message';
+        el.title = heading.placed_by === 'tf' ? 'the sensor\'s mount on the robot taken out through TF' : `as ${heading.topic} reports it`;
       }
       drawHeading();
     },

@@ -8,6 +8,7 @@ import pytest
 import requests
 
 from rover_web.overlays.costmap import decode
+from rover_web.sim.frames import LASER, laser_origin
 from tests.support.waiting import wait_until
 
 pytestmark = pytest.mark.ros
@@ -196,17 +197,38 @@ def test_the_simulator_publishes_every_layer(live_server, sim_process, sse_clien
         stream.wait_for(channel, timeout=30)
     event = stream.wait_for("costmap", lambda d: len(d["costmaps"]) == 2, timeout=30)["json"]
     assert [c["topic"] for c in event["costmaps"]] == ["/global_costmap/costmap", "/local_costmap/costmap"]
-    scan = stream.wait_for("scan", lambda d: d["points"])["json"]
+    # Its laser is mounted upside down, turned and off centre (sim/frames.py): placed through TF.
+    scan = stream.wait_for("scan", lambda d: d["points"] and d["placed_by"] == "tf")["json"]
     assert scan["frame_id"] == "base_scan" and scan["beams"] == 360
     # The basement's Dock (2.0, 10.5) has a wall 1.85 m to its west: the scan sees it there.
     points = np.array(scan["points"]).reshape(-1, 2)
     assert np.hypot(points[:, 0] - 0.15, points[:, 1] - 10.5).min() < 0.1
-    markers = stream.wait_for("markers", lambda d: any(m["type"] == "text" for m in d["markers"]))["json"]
+    # And every return lies on a wall of the floorplan (within a cell and a half).
+    assert on_walls(points) == 1.0
+    markers = stream.wait_for("markers", lambda d: {"text", "arrow"} <= {m["type"] for m in d["markers"]})["json"]
     assert {m["type"] for m in markers["markers"]} >= {"sphere", "text", "line_strip", "arrow"}
+    assert next(m for m in markers["markers"] if m["type"] == "arrow")["placed_by"] == "tf"  # in base_link
     trail = requests.get(live_server.url + "/api/overlays", timeout=5).json()
-    # Nothing the simulator sends is bad (a scan heard before its first pose cannot be placed, though).
+    # Nothing the simulator sends is bad (what came before TF and the first pose cannot be placed, though).
     assert set(trail["layers"]["scan"]["skipped_by_reason"]) <= {"no_pose"}
-    assert trail["layers"]["costmap"]["skipped"] == 0 and trail["layers"]["markers"]["skipped"] == 0
+    # The local costmap is in odom: one latched before the first TF cannot be placed yet.
+    assert set(trail["layers"]["costmap"]["skipped_by_reason"]) <= {"unknown_frame"}
+    assert set(trail["layers"]["markers"]["skipped_by_reason"]) <= {"no_pose"}
+    assert {trail["layers"][name]["placed_by"] for name in ("scan", "footprint")} == {"tf"}
+    assert trail["costmaps_placed_by"] == {"/global_costmap/costmap": "map", "/local_costmap/costmap": "tf"}
+
+
+def on_walls(points, within_m=0.075):
+    """The share of points within `within_m` of an occupied cell of the simulator's floorplan."""
+    from rover_web.sim.rover import first_map
+    from rover_web.sim.sensors import Floorplan
+
+    plan = Floorplan.from_definition(first_map())
+    rows, cols = np.nonzero(plan.walls)
+    centres = np.column_stack((plan.origin_x + (cols + 0.5) * plan.resolution,
+                               plan.origin_y + (rows + 0.5) * plan.resolution))
+    near = [np.min(np.abs(centres - p).max(axis=1)) <= within_m + plan.resolution / 2 for p in points]
+    return float(np.mean(near))
 
 
 def test_a_local_costmap_and_footprint_in_odom_are_placed_with_amcl_s_map_to_odom(live_server, posed, sse_client):
@@ -235,3 +257,31 @@ def test_a_local_costmap_and_footprint_in_odom_are_placed_with_amcl_s_map_to_odo
               "polygon": {"points": [{"x": 1.0, "y": 0.0}, {"x": 2.0, "y": 0.0}, {"x": 2.0, "y": 1.0}]}}
     foot = publish_until(posed, "/global_costmap/published_footprint", square, stream, "footprint")
     assert foot["polygon"] == [[10.0, 10.0], [10.0, 11.0], [9.0, 11.0]]
+
+
+def test_after_an_initial_pose_the_simulator_s_map_to_odom_moves_and_its_scan_still_lies_on_the_walls(
+        live_server, sim_process, ros_peer, sse_client):
+    """The simulator relocalises as AMCL does (map -> odom moves, odometry's position does not jump):
+    the scan, placed through map -> odom -> base_link -> base_scan, is on the walls at the new pose."""
+    sim_process("--only", "rover")
+    stream = sse_client(live_server.url + "/api/events?channels=scan")
+    stream.wait_for("scan", lambda d: d["placed_by"] == "tf", timeout=30)
+    peer = ros_peer("initial_pose_peer")
+    peer.advertise("/initialpose", AMCL)
+    peer.wait_match("/initialpose")
+    x, y, yaw = 18.0, 10.5, 2.5   # the middle of the basement's corridor, facing west-north-west
+    pose = {**amcl(x, y, yaw), "header": {"frame_id": "map"}}
+
+    def moved():
+        peer.publish("/initialpose", pose)
+        odom = requests.get(live_server.url + "/api/tf/lookup", params={"target": "map", "source": "odom"},
+                            timeout=5)
+        return odom.ok and abs(odom.json()["translation"][0]) > 1.0 and odom.json()
+    map_odom = wait_until(moved, timeout=15, interval=0.5, what="map -> odom moved by the initial pose")
+    assert map_odom["yaw"] == pytest.approx(0.0, abs=1e-9)   # a position correction; odom stays map-aligned
+    lx, ly, heading = laser_origin((x, y, yaw))
+    scan = stream.wait_for("scan", lambda d: d["points"] and abs(d["pose"][0] - lx) < 0.01, timeout=15)["json"]
+    assert scan["pose"][:2] == pytest.approx([lx, ly], abs=0.01) and scan["placed_by"] == "tf"
+    assert math.cos(scan["pose"][2] - heading) == pytest.approx(1.0, abs=1e-4)
+    assert LASER.frame == scan["frame_id"]
+    assert on_walls(np.array(scan["points"]).reshape(-1, 2)) == 1.0

@@ -36,11 +36,13 @@ def test_boat_and_drone_run_in_their_namespaces_and_driving_the_boat_moves_only_
         "/boat/cmd_vel": "subscribers", "/boat/goal_pose": "subscribers", "/boat/light_buoy/new_code": "subscribers",
         "/boat/odom": "publishers", "/boat/fix": "publishers", "/boat/amcl_pose": "publishers",
         "/boat/diagnostics": "publishers", "/boat/light_sequence": "publishers",
+        "/boat/tf": "publishers", "/boat/tf_static": "publishers",  # its frames, as Nav2's multi-robot remaps
         "/drone/control_phase": "subscribers", "/drone/flight_destination": "subscribers",
         "/drone/status": "publishers", "/drone/id": "publishers", "/drone/camera/image_raw": "publishers",
     }
-    root = ["/cmd_vel", "/odom", "/fix", "/status", "/control_phase", "/camera/image_raw", "/light_sequence",
-            "/diagnostics", "/drone/cmd_vel", "/drone/odom", "/boat/status", "/boat/camera/image_raw"]
+    root = ["/tf", "/tf_static", "/cmd_vel", "/odom", "/fix", "/status", "/control_phase", "/camera/image_raw",
+            "/light_sequence", "/diagnostics", "/drone/cmd_vel", "/drone/odom", "/boat/status",
+            "/boat/camera/image_raw"]
     nodes = {"/boat/sim_rover", "/boat/light_buoy", "/drone/sim_drone", "/drone/sim_camera"}
     # Graph discovery lags data (node names later still): wait until every namespaced endpoint and
     # node is seen, then look for stray ones.

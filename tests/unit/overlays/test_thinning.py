@@ -31,6 +31,26 @@ def test_thinning_keeps_the_nearest_return_of_every_bin():
     assert angles[i] == pytest.approx(-math.pi + 1079 * 2 * math.pi / 1080)
 
 
+def test_a_bin_keeps_its_farthest_return_too_when_it_stands_out_a_doorway_or_a_long_beam():
+    ranges = np.full(1080, 2.0, dtype=np.float32)
+    ranges[0::3] = 1.9                      # each bin of three: a nearest at 1.9 m
+    ranges[301] = 25.0                      # one 25 m beam among walls (bin 100)
+    ranges[600:603] = [5.0, 4.8, 5.2]       # a doorway filling bin 200: its nearest 4.8, farthest 5.2
+    ranges[900] = float("nan")              # bin 300: its valid returns 2.0, 2.0: nothing stands out
+    t = scan.thin_both(make_scan(ranges), 360)
+    assert len(t.ranges) == 360 and t.invalid == 1
+    assert t.ranges[100] == pytest.approx(1.9) and t.ranges[200] == pytest.approx(4.8)
+    # Only the bins whose farthest is >= FAR_MIN_GAP_M beyond their nearest: the long beam and the doorway.
+    assert t.far_ranges.tolist() == pytest.approx([25.0, 5.2])
+    step = 2 * math.pi / 1080
+    assert t.far_angles == pytest.approx([-math.pi + 301 * step, -math.pi + 602 * step])
+    # The nearest-only thinning drops the 25 m beam: what the far return is for.
+    assert 25.0 not in scan.thin(make_scan(ranges), 360)[1]
+    # A scan no denser than its bins keeps every beam once, as nearest.
+    few = scan.thin_both(make_scan([1.0, 9.0, 2.0]), 360)
+    assert few.ranges.tolist() == [1.0, 9.0, 2.0] and few.far_ranges.size == 0
+
+
 def test_invalid_returns_are_dropped_and_counted():
     ranges = [1.0, float("nan"), float("inf"), -float("inf"), 0.05, 31.0, 2.0, 3.0]
     angles, kept, invalid = scan.thin(make_scan(ranges), 360)

@@ -12,6 +12,14 @@ const OPACITY_KEY = 'rover_web.livemap.costmap_opacity';
 const COUNTS_EVERY_MS = 2000;
 const TRAIL_MAX_POINTS = 2000;
 const TRAIL_STEP_M = 0.05;
+// What placed a layer's latest message on the map (the server's `placed_by`).
+const PLACED_LABELS = { tf: 'placed by TF', configured: 'placed by configured offsets', map: 'in the map frame', amcl: 'placed by AMCL' };
+
+function showPlaced(el, how) {
+  if (!el || !how || el.dataset.placed === how) return;
+  el.dataset.placed = how;
+  el.textContent = PLACED_LABELS[how] || how;
+}
 
 function remembered() {
   try { return JSON.parse(localStorage.getItem(STORAGE_KEY) || '{}') || {}; } catch { return {}; }
@@ -42,9 +50,10 @@ export function createLayers(panel, redraw) {
     });
   }
 
-  on('scan', (scan) => { L.scan = scan; redraw(); });
+  const placedEl = (name) => document.getElementById(`overlay-placed-${name}`);
+  on('scan', (scan) => { L.scan = scan; showPlaced(placedEl('scan'), scan.placed_by); redraw(); });
   on('markers', (m) => { L.markers = m.markers; redraw(); });
-  on('footprint', (f) => { L.footprint = f; redraw(); });
+  on('footprint', (f) => { L.footprint = f; showPlaced(placedEl('footprint'), f.placed_by); redraw(); });
   // A grid is decoded only when it is new (its seq changed); the others keep their canvases.
   function decode(layer) {
     renderCostmap(layer).then((canvas) => {
@@ -74,6 +83,11 @@ export function createLayers(panel, redraw) {
     }
   });
   on('pose', (p) => {
+    const robot = document.getElementById('livemap-robot-placed');
+    if (robot && p.placed_by && robot.dataset.placed !== p.placed_by) {
+      robot.dataset.placed = p.placed_by;
+      robot.textContent = `Robot: ${PLACED_LABELS[p.placed_by] || p.placed_by}`;
+    }
     if (p.stale) return;
     const last = L.trail[L.trail.length - 1];
     if (last && Math.hypot(p.x - last[0], p.y - last[1]) < TRAIL_STEP_M) return;
@@ -93,6 +107,7 @@ export function createLayers(panel, redraw) {
         const reasons = Object.entries(c.skipped_by_reason).map(([k, v]) => `${k}: ${v}`);
         if (c.dropped_items) reasons.push(`${c.dropped_items} ${name === 'scan' ? 'beams without a return' : 'items left out'}`);
         if (el) el.title = `${c.received} received, ${c.converted} drawn${reasons.length ? `; ${reasons.join(', ')}` : ''}`;
+        showPlaced(placedEl(name), c.placed_by);
       }
       L.counts = summary.layers;
       redraw();
@@ -103,7 +118,7 @@ export function createLayers(panel, redraw) {
 
   const state = () => ({
     shown: { ...shown }, opacity: L.opacity,
-    scan: L.scan ? { points: L.scan.points.length / 2, beams: L.scan.beams } : null,
+    scan: L.scan ? { points: L.scan.points.length / 2, far: (L.scan.far_points || []).length / 2, beams: L.scan.beams, placed_by: L.scan.placed_by } : null,
     costmaps: [...L.costmaps.values()].map(({ layer }) => ({ topic: layer.topic, seq: layer.seq, width: layer.width, height: layer.height })),
     markers: L.markers.length, footprint: L.footprint ? L.footprint.polygon.length : 0, trail: L.trail.length,
     counts: L.counts || null,

@@ -3,6 +3,8 @@
 export const LAYER_COLORS = { scan: '#ff3b30', footprint: '#e3b341', path: '#58a6ff' };
 const SCAN_DOT_PX = 3;
 
+// Each bin's nearest return as a filled dot; its farthest (a doorway, a long beam between walls),
+// sent only where it stands out, as a hollow one, so the two read apart.
 export function drawScan(ctx, toScreen, scan) {
   const p = scan.points;
   ctx.fillStyle = LAYER_COLORS.scan;
@@ -11,7 +13,18 @@ export function drawScan(ctx, toScreen, scan) {
     const [sx, sy] = toScreen(p[i], p[i + 1]);
     ctx.fillRect(sx - half, sy - half, SCAN_DOT_PX, SCAN_DOT_PX);
   }
-  return p.length / 2;
+  const far = scan.far_points || [];
+  if (far.length) {
+    ctx.strokeStyle = LAYER_COLORS.scan;
+    ctx.lineWidth = 1;
+    ctx.beginPath();
+    for (let i = 0; i + 1 < far.length; i += 2) {
+      const [sx, sy] = toScreen(far[i], far[i + 1]);
+      ctx.rect(sx - half - 0.5, sy - half - 0.5, SCAN_DOT_PX + 1, SCAN_DOT_PX + 1);
+    }
+    ctx.stroke();
+  }
+  return (p.length + far.length) / 2;
 }
 
 function polyline(ctx, toScreen, points, close) {
