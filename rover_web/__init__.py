@@ -77,6 +77,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         layouts,
         livemap,
         logs,
+        nav2,
         overlays,
         panels,
         plot,
@@ -120,6 +121,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         scan_the_code.init_app(app, fleet)
         panels.init_app(app, fleet)
         livemap.init_app(app, fleet)
+        nav2.init_app(app, fleet)  # after livemap: goals are checked on its maps; its panel is on LiveMap
         overlays.init_app(app, fleet)  # what the robot senses, on LiveMap
         camera.init_app(app, fleet)
         topics.init_app(app, graph)

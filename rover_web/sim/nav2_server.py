@@ -5,7 +5,8 @@
                           distance_remaining), cancel; aborted with the planner's error code when unreachable
   navigate_through_poses  NavigateThroughPoses: one path through every pose, stopping only at the last
   follow_waypoints        FollowWaypoints: each pose in turn, stopping at each; feedback current_waypoint;
-                          a waypoint it cannot reach is missed (missed_waypoints) and the next one driven
+                          a waypoint it cannot reach is missed (missed_waypoints, with the planner's code) and
+                          the next one driven; none reached: aborted, TASK_EXECUTOR_FAILED
   <node>/get_state        lifecycle_msgs/GetState for bt_navigator, planner_server and the rest: active
 
 Like bt_navigator, a new goal of any of the three preempts the running one (aborted), and so do a
@@ -47,8 +48,7 @@ REPLAN_LIMIT = 3
 # nav2_msgs result codes (Jazzy)
 NAVIGATE_UNKNOWN = 9000          # NavigateToPose / NavigateThroughPoses
 FAILED_TO_MAKE_PROGRESS = 105    # FollowPath
-NO_VALID_WAYPOINTS = 602         # FollowWaypoints
-WAYPOINT_COMPLETED, WAYPOINT_FAILED = 1, 3  # nav2_msgs/msg/WaypointStatus
+TASK_EXECUTOR_FAILED = 601       # FollowWaypoints: no waypoint could be reached
 
 
 def _wrap(angle: float) -> float:
@@ -124,7 +124,7 @@ class Nav2Sim:
         self.available = False
         try:
             from nav2_msgs.action import FollowWaypoints, NavigateThroughPoses, NavigateToPose
-            from nav2_msgs.msg import WaypointStatus
+            from nav2_msgs.msg import MissedWaypoint
         except ImportError:
             node.get_logger().warning("nav2_msgs is not installed: no Nav2 actions in this simulator "
                                       "(build it with scripts/build_interfaces.sh)")
@@ -132,7 +132,7 @@ class Nav2Sim:
         from rclpy.action import ActionServer, CancelResponse
 
         self._types = {"to_pose": NavigateToPose, "through_poses": NavigateThroughPoses, "waypoints": FollowWaypoints}
-        self._waypoint_status = WaypointStatus
+        self._missed_waypoint = MissedWaypoint
         names = {"to_pose": "navigate_to_pose", "through_poses": "navigate_through_poses",
                  "waypoints": "follow_waypoints"}
         self._servers = [
@@ -173,7 +173,7 @@ class Nav2Sim:
                    else "no poses" if not targets else "a pose that is not finite")
             self.node.get_logger().warning(f"Nav2 goal refused: {why}")
             handle.abort()
-            return self._result(kind, NO_VALID_WAYPOINTS if kind == "waypoints" else NAVIGATE_UNKNOWN, why)
+            return self._result(kind, TASK_EXECUTOR_FAILED if kind == "waypoints" else NAVIGATE_UNKNOWN, why)
         self.node.follower.cancel()
         self.node.mission.cancel("a Nav2 goal")
         job = Job(kind, handle, targets, self._future(), time.monotonic())
@@ -191,7 +191,7 @@ class Nav2Sim:
             self._miss(job, exc)
             if not self._next_waypoint(job, d.x, d.y):
                 handle.abort()
-                return self._result(kind, NO_VALID_WAYPOINTS, "no waypoint could be reached", job.missed, targets)
+                return self._result(kind, TASK_EXECUTOR_FAILED, "no waypoint could be reached", job.missed, targets)
         self.job = job
         self.node.get_logger().info(f"Nav2 {kind} goal accepted: {len(targets)} pose(s)")
         return await job.done
@@ -269,7 +269,7 @@ class Nav2Sim:
             if not self._next_waypoint(job, x, y):
                 all_missed = len(job.missed) == len(job.targets)
                 self._finish(job, "abort" if all_missed else "succeed",
-                             NO_VALID_WAYPOINTS if all_missed else 0,
+                             TASK_EXECUTOR_FAILED if all_missed else 0,
                              "no waypoint could be reached" if all_missed else "")
                 return 0.0, 0.0
             command = job.drive.command(x, y, yaw)
@@ -334,15 +334,9 @@ class Nav2Sim:
         if hasattr(result, "error_msg"):
             result.error_msg = message
         if kind == "waypoints":
-            for index, wcode, wmessage in missed:
-                status = self._waypoint_status()
-                status.waypoint_status = WAYPOINT_FAILED
-                status.waypoint_index = index
-                status.waypoint_pose = self._pose(*targets[index])
-                status.error_code = wcode
-                if hasattr(status, "error_msg"):
-                    status.error_msg = wmessage
-                result.missed_waypoints.append(status)
+            for index, wcode, _message in missed:  # MissedWaypoint has no room for the message (Jazzy)
+                result.missed_waypoints.append(
+                    self._missed_waypoint(index=index, goal=self._pose(*targets[index]), error_code=wcode))
         return result
 
     def _pose(self, x: float, y: float, yaw: float) -> PoseStamped:
