@@ -75,6 +75,7 @@ class Nav2Service:
         self._lifecycle: dict[str, dict] = {n: {"node": n, "state": "unknown", "checked": None}
                                             for n in self.lifecycle_nodes}
         self._lifecycle_since: float | None = None
+        self._servers_seen: tuple | None = None
         self.watching = threading.Event()  # set once the client exists: the lifecycle loop runs then
         estop.on_engage(lambda by: self.cancel_active("e-stop", f"the e-stop was engaged by {by}"))
 
@@ -255,5 +256,7 @@ class Nav2Service:
                     entry = self._lifecycle[node]
                     changed |= entry["state"] != state
                     entry.update(state=state, checked=time.time())
-        if changed:
+        servers = (self.goal_via(), tuple(client.server_ready(n) for n in self.actions.values()))
+        if changed or servers != self._servers_seen:  # a Nav2 that came up (or went) shows without a goal
+            self._servers_seen = servers
             self.publish()

@@ -137,7 +137,7 @@ class Nav2Sim:
                  "waypoints": "follow_waypoints"}
         self._servers = [
             ActionServer(node, self._types[kind], name,
-                         execute_callback=lambda handle, kind=kind: self._execute(handle, kind),
+                         execute_callback=self._executor_of(kind),
                          cancel_callback=lambda _handle: CancelResponse.ACCEPT)
             for kind, name in names.items()]
         self._lifecycle = [node.create_service(GetState, f"{name}/get_state", self._get_state)
@@ -156,6 +156,11 @@ class Nav2Sim:
         return response
 
     # --- goals ---
+
+    def _executor_of(self, kind: str):
+        async def execute(handle):  # a coroutine function: rclpy awaits it on the executor, not a thread
+            return await self._execute(handle, kind)
+        return execute
 
     async def _execute(self, handle, kind: str):
         request = handle.request
