@@ -88,6 +88,17 @@ def _checked(map_name: str | None, poses: list[tuple[float, float, float]]) -> s
     return definition.name
 
 
+@bp.app_context_processor
+def panel_context() -> dict:
+    """`nav2_panel` for LiveMap's page (templates/partials/nav2_panel.html): the state GET /api/nav2 answers."""
+    if request.endpoint != "livemap.livemap_page":
+        return {}
+    service = current_feature(Nav2Service)
+    if service.missing is None:
+        service.client()  # an operator is looking: discovery of Nav2's servers starts now
+    return {"nav2_panel": service.state()}
+
+
 @bp.get("/api/nav2")
 def nav2_state():
     service = current_feature(Nav2Service)
