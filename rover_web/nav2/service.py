@@ -182,6 +182,11 @@ class Nav2Service:
             log.info("nav2: %s goal %s: %s %s", kind, status, values.get("error_code"), values.get("error_msg"))
             self.publish()
 
+        if (not client.server_ready(self.actions[kind])
+                and time.monotonic() - (self._lifecycle_since or 0.0) > DISCOVERY_S):
+            # Discovery has had its time: no server now is no Nav2, not a slow one (no 3 s wait per click).
+            raise Nav2Unavailable("no_nav2_server", f"no action server for {self.actions[kind]}: is Nav2 running "
+                                                    "(bt_navigator active)?")
         try:
             sent = client.send_goal(msgs.action_type(kind), self.actions[kind], message, self.timeout_s,
                                     on_feedback, on_result)
