@@ -8,6 +8,7 @@ ros-common-interfaces and is always there.
 from __future__ import annotations
 
 import importlib
+import importlib.util
 
 from rover_web.ros.convert import quaternion_from_yaw, stamp_to_float, yaw_from_quaternion
 
@@ -42,10 +43,16 @@ LIFECYCLE_STATES = {0: "unknown", 1: "unconfigured", 2: "inactive", 3: "active",
 _error_names: dict[int, str] | None = None
 
 
-def missing() -> str | None:
-    """Why Nav2's actions cannot be used here (what is missing and how to get it), or None."""
+def missing(load: bool = False) -> str | None:
+    """Why Nav2's actions cannot be used here (what is missing and how to get it), or None.
+
+    At start only found, not loaded (`load=False`): a robot nobody navigates from the GUI does not
+    pay for nav2_msgs' classes (issue 32: idle RSS). The first real use loads it (`load=True`)."""
     try:
-        importlib.import_module("nav2_msgs.action")
+        if load:
+            importlib.import_module("nav2_msgs.action")
+        elif importlib.util.find_spec("nav2_msgs.action") is None:
+            return f"nav2_msgs is not installed. {HOW_TO_GET}"
     except ImportError as exc:
         return f"nav2_msgs could not be imported ({exc}). {HOW_TO_GET}"
     return None

@@ -94,22 +94,21 @@ def panel_context() -> dict:
     if request.endpoint != "livemap.livemap_page":
         return {}
     service = current_feature(Nav2Service)
-    if service.missing is None:
-        service.client()  # an operator is looking: discovery of Nav2's servers starts now
+    service.client()  # an operator is looking: discovery of Nav2's servers starts now
     return {"nav2_panel": service.state()}
 
 
 @bp.get("/api/nav2")
 def nav2_state():
     service = current_feature(Nav2Service)
-    if service.missing is None:
-        service.client()  # discovery of Nav2's servers starts with the first look
+    service.client()  # discovery of Nav2's servers starts with the first look
     return jsonify(service.state())
 
 
 @bp.post("/api/nav2/goal")
 def post_goal():
     service = current_feature(Nav2Service)
+    service.client()
     body = json_body()
     try:
         only_keys(body, {"map", "x", "y", "yaw"})
@@ -127,6 +126,7 @@ def post_goal():
 @bp.post("/api/nav2/route")
 def post_route():
     service = current_feature(Nav2Service)
+    service.client()
     body = json_body()
     try:
         only_keys(body, {"map", "mode", "poses"})

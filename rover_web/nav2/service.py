@@ -87,6 +87,9 @@ class Nav2Service:
                 if self._client is None:
                     from rover_web.ros.goal_client import GoalClient
 
+                    if self.missing is None:
+                        self.missing = msgs.missing(load=True)  # found at start; loaded only now
+
                     self._client = GoalClient(self.rover.runtime, self.rover.robot.namespace)
                     if self.missing is None:
                         for kind, name in self.actions.items():  # discovery starts now, not at the first goal
