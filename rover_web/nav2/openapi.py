@@ -32,13 +32,13 @@ PATHS = {
     "/api/nav2/goal": {
         "post": op("Send a NavigateToPose goal in the map's frame", tag="nav2", role="operator", ok=SENT,
                    body=obj({"map": MAP, "x": NUMBER, "y": NUMBER, "yaw": NUMBER}, ("x", "y")),
-                   errors={400: BAD, **SENDING}, fuzz="last", fuzz_why="a goal moves the simulated robot"),
+                   errors={400: BAD, **SENDING}),
     },
     "/api/nav2/route": {
         "post": op("Send a route: NavigateThroughPoses or FollowWaypoints", tag="nav2", role="operator", ok=SENT,
                    body=obj({"map": MAP, "mode": {"enum": ["through_poses", "follow_waypoints"]},
                              "poses": {"type": "array", "items": POSE, "minItems": 1}}, ("mode", "poses")),
-                   errors={400: BAD, **SENDING}, fuzz="last", fuzz_why="a route moves the simulated robot"),
+                   errors={400: BAD, **SENDING}),
     },
     "/api/nav2/cancel": {
         "post": op("Cancel the Nav2 goal sent from here", tag="nav2", role="operator", ok=SENT, body=obj(),
