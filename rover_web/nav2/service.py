@@ -177,6 +177,13 @@ class Nav2Service:
                     return
                 self._goal["status"] = status
                 self._goal["ended_at"] = time.time()
+                if status == "canceled" and self._goal["cancel"] is None:
+                    # Canceled by a CancelGoal not sent from here: while the e-stop is engaged, its
+                    # canceller's (it cancels every goal, and Nav2 may answer before the e-stop's
+                    # hooks have reached this feature's).
+                    by = "e-stop" if self.estop.engaged else "another client"
+                    self._goal["cancel"] = {"by": by, "reason": f"canceled by {by}'s CancelGoal", "at": time.time(),
+                                            "answer": "canceled"}
                 self._result = values
                 self._handle = None
                 registration, self._registration = self._registration, None

@@ -3,15 +3,22 @@ answers them as Nav2 does: goals around the walls with feedback, routes, unreach
 Nav2's error codes, cancel by the operator, the e-stop and revocation, the keep-out areas."""
 
 import math
+import os
+import signal
+import subprocess
+import sys
+import threading
 import time
 
 import pytest
 import requests
 
+from rover_web.config import ROOT
 from rover_web.livemap.map_files import load_catalog, maps_file_path
 from rover_web.sim.rover import default_start
 from rover_web.sim.walls import Walls
 from tests.support.auth import bearer
+from tests.support.rospeer import subprocess_env
 from tests.support.waiting import wait_until
 
 pytestmark = pytest.mark.ros
@@ -54,6 +61,12 @@ def blocked_point() -> tuple[float, float]:
 
 def test_a_goal_is_driven_around_the_walls_with_feedback_to_success(live_server, sim_process, sse_client):
     sim_process("--only", "rover", "--goal-speed", "2.0")
+    node = live_server.rover.runtime.node
+
+    def main_node_entities():
+        return len(list(node.clients)), len(list(node.waitables)), len(list(node.subscriptions))
+
+    before = main_node_entities()  # before the first look, which makes the Nav2 clients' own node
     first = ready(live_server)
     assert first["available"] and first["missing"] is None
     assert first["goal_via"] == "action"  # auto: the server is there
@@ -83,6 +96,8 @@ def test_a_goal_is_driven_around_the_walls_with_feedback_to_success(live_server,
     span = with_feedback[-1]["t"] - with_feedback[0]["t"]
     assert len(with_feedback) <= span * 5 + 2  # the simulator sends 20 a second
     wait_until(lambda: events.of("nav2")[-1]["json"]["result"], 5, "the result on the nav2 channel")
+    # The action and GetState clients are on their own node: the main executor's wait set is untouched.
+    assert main_node_entities() == before
 
 
 def test_an_unreachable_goal_ends_aborted_with_nav2s_error_code(live_server, sim_process):
@@ -224,3 +239,31 @@ def test_a_revoked_token_cancels_the_goal_it_sent(signed_server, sim_process):
     done = result_of(signed_server, goal["id"], headers=admin)
     assert done["result"]["status"] == "canceled"
     assert done["goal"]["cancel"]["by"] == "revocation" and "revoked" in done["goal"]["cancel"]["reason"]
+
+
+def test_the_simulator_runs_without_nav2_msgs_and_says_why(tmp_path, ros_peer):
+    hidden = tmp_path / "hide" / "nav2_msgs"
+    hidden.mkdir(parents=True)
+    (hidden / "__init__.py").write_text('raise ImportError("nav2_msgs is hidden by this test")\n')
+    sim = subprocess.Popen([sys.executable, "-m", "rover_web.sim", "--only", "rover"], cwd=ROOT, text=True,
+                           env=subprocess_env(PYTHONPATH=f"{hidden.parent}{os.pathsep}{ROOT}"),
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    lines: list[str] = []
+    reader = threading.Thread(target=lambda: lines.extend(sim.stdout), daemon=True)
+    reader.start()
+    try:
+        peer = ros_peer()
+        peer.subscribe("/odom", "nav_msgs/msg/Odometry", qos="sensor_data")
+        peer.wait_for("/odom", timeout=20)  # the robot runs
+        wait_until(lambda: any("nav2_msgs is not installed: no Nav2 actions" in line for line in lines), 10,
+                   "the simulator's warning")
+        assert any("simulator running" in line for line in lines)
+    finally:
+        sim.send_signal(signal.SIGINT)
+        try:
+            sim.wait(10)
+        except subprocess.TimeoutExpired:
+            sim.kill()
+            sim.wait(5)
+        reader.join(5)
+        sim.stdout.close()
