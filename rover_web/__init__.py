@@ -82,6 +82,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         livemap,
         logs,
         metrics,
+        nav2,
         overlays,
         panels,
         plot,
@@ -132,6 +133,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         scan_the_code.init_app(app, fleet)
         panels.init_app(app, fleet)
         livemap.init_app(app, fleet)
+        nav2.init_app(app, fleet)  # after livemap: goals are checked on its maps; its panel is on LiveMap
         overlays.init_app(app, fleet)  # what the robot senses, on LiveMap
         view3d.init_app(app, fleet)  # after overlays (it shares their markers subscription) and tf
         camera.init_app(app, fleet)

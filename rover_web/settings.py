@@ -242,6 +242,19 @@ SETTINGS: tuple[Setting, ...] = (
             "the map shows 'no pose' when the last pose is older than this; 0: never (AMCL only publishes when moving)",
             0, 3600),
     Setting("LIVEMAP_PLAN_MAX_POINTS", 500, "int", "longer paths are evenly thinned to this many points", 2, 100000),
+    # --- Nav2's actions (docs/nav2.md) ---
+    Setting("NAV2_GOAL_MODE", "auto", "str",
+            "how LiveMap sends a goal: action (Nav2's NavigateToPose, with feedback and a result), topic "
+            "(ROVER_WEB_GOAL_TOPIC) or auto (the action when nav2_msgs is installed and the server answers)",
+            choices=("auto", "action", "topic")),
+    Setting("NAV2_FEEDBACK_MAX_HZ", 5.0, "float", "most `nav2` channel updates a second (feedback, states)", 0.5, 50),
+    Setting("NAV2_TIMEOUT_S", 3.0, "float", "how long a goal waits for Nav2's action server to accept it", 0.2, 30),
+    Setting("NAV2_MAX_POSES", 100, "int", "most poses in a route (NavigateThroughPoses, FollowWaypoints)", 1, 10000),
+    Setting("NAV2_LIFECYCLE_NODES", ["bt_navigator", "planner_server", "controller_server", "behavior_server",
+                                     "smoother_server", "velocity_smoother", "waypoint_follower", "map_server",
+                                     "amcl"], "list",
+            "Nav2 servers whose lifecycle state (<node>/get_state) is shown, under the robot's namespace"),
+    Setting("NAV2_LIFECYCLE_PERIOD_S", 2.0, "float", "how often the lifecycle states are asked for", 0.2, 60),
     # --- livemap overlays: what the robot senses (docs/livemap.md#overlays-what-the-robot-senses) ---
     Setting("SCAN_TOPIC", "/scan", "optional_topic", "sensor_msgs/LaserScan drawn on LiveMap; empty: off"),
     Setting("SCAN_MAX_POINTS", 360, "int", "angular bins a scan is thinned to, each its nearest return", 8, 10000),

@@ -4,7 +4,8 @@ Roles, each including the ones below it:
   viewer    every GET (pages, APIs, SSE, camera, topic echo) and ENGAGING the e-stop: anyone who
             sees danger must be able to stop the robot.
   operator  also everything that moves or commands the robot: driving (the teleop WebSocket and
-            REST), taking over, releasing the e-stop, LiveMap goals and initial poses, waypoint writes,
+            REST), taking over, releasing the e-stop, LiveMap goals and initial poses, Nav2's goals,
+            routes and cancels (POST /api/nav2/...: the default below), waypoint writes,
             the mission send, panel unlock and commands, canceling a goal sent from /ros.
   admin     also users and API tokens (refused to everyone while sign-in is off: the CLI remains),
             and /ros's writes: other nodes' parameters, service calls, action goals (root over the

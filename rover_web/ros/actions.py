@@ -79,7 +79,9 @@ class GoalCanceller:
                 outcomes[name] = outcome
                 done = all(n in outcomes for n, _ in pending)
                 late = finished.is_set()
-                result = [outcomes[n] for n in self._clients]
+                # Only once every action has an outcome (after the timeout, `finish` gave the rest one):
+                # before that, the answers still awaited have none.
+                result = [outcomes[n] for n in self._clients] if done or late else None
             if late:
                 on_done(result)
             elif done:

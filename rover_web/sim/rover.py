@@ -18,6 +18,8 @@ navigating robot.
 
 It also drives a GPS mission sent on /mission (mission.py), stops or slides at the floorplan's
 walls (walls.py) and publishes /battery_state from a pack that drains as it drives (battery.py).
+With nav2_msgs installed it answers Nav2's navigate_to_pose, navigate_through_poses and
+follow_waypoints, planning around those walls (nav2_server.py, planner.py).
 """
 
 from __future__ import annotations
@@ -199,6 +201,8 @@ class RoverSim(Node):
         self.last_stamp = self.get_clock().now().to_msg()  # of the latest odometry: the pose sensors use
         self.create_subscription(PoseStamped, goal_topic, self._on_goal, 10)
         self.mission = MissionDriver(self)
+        from .nav2_server import Nav2Sim
+        self.nav2 = Nav2Sim(self, walls, goal_speed_mps)
         # Standing in for AMCL: an operator's initial pose (LiveMap's Set pose) puts the robot there.
         self.create_subscription(PoseWithCovarianceStamped, "initialpose", self._on_initial_pose, 10)
         self._dt = 1.0 / rate_hz
@@ -235,6 +239,7 @@ class RoverSim(Node):
             _LOG[level](self.get_logger(), text)
 
     def _on_cmd(self, twist) -> None:
+        self.nav2.operator_command(twist.linear.x, twist.angular.z, time.monotonic())
         self.mission.cancel("operator command on cmd_vel")
         if self.follower.cancel():
             self.get_logger().info("operator command on cmd_vel: goal cancelled")
@@ -248,6 +253,7 @@ class RoverSim(Node):
         q = msg.pose.orientation
         x, y = msg.pose.position.x, msg.pose.position.y
         self.mission.cancel("a new goal")
+        self.nav2.preempt("a goal on goal_pose")
         if self.follower.set_goal(x, y, yaw_from_quaternion(q.x, q.y, q.z, q.w)):
             self.get_logger().info(f"goal ({x:.2f}, {y:.2f}) received")
             self.plan_pub.publish(self._plan(self.follower.goal))
@@ -265,7 +271,14 @@ class RoverSim(Node):
 
     def _tick(self) -> None:
         now = time.monotonic()
-        if self.follower.active:
+        if self.follower.active and self.nav2.active:
+            self.nav2.preempt("a mission")
+        if self.nav2.active:
+            d = self.drive
+            command = self.nav2.tick(d.x, d.y, d.yaw, d.linear, now)
+            if command is not None:
+                d.command(*command, now)
+        elif self.follower.active:
             d = self.drive
             linear, angular = self.follower.command(d.x, d.y, d.yaw)
             d.command(linear, angular, now)

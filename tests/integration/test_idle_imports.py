@@ -8,7 +8,7 @@ import json
 import subprocess
 import sys
 
-DEFERRED = ("shapely", "PIL.Image", "lz4", "zstandard", "mcap.stream_reader", "rclpy.action")
+DEFERRED = ("shapely", "PIL.Image", "lz4", "zstandard", "mcap.stream_reader", "rclpy.action", "nav2_msgs.action")
 
 SCRIPT = """
 import json, sys

@@ -40,9 +40,12 @@ export function attachInput(canvas, S, act) {
     S.preview = null;
   }
 
-  function sendGoalFrom(sx, sy, ex, ey) {
+  // Shift held: the point joins the Nav2 route being made (act.addToRoute) instead of going as a goal.
+  function sendGoalFrom(sx, sy, ex, ey, toRoute) {
     const [x, y] = screenToWorld(S.geometry, S.view, sx, sy);
-    act.sendGoal(x, y, gestureYaw(S.geometry, sx, sy, ex, ey, x, y, act.livePose()), 'map point');
+    const yaw = gestureYaw(S.geometry, sx, sy, ex, ey, x, y, act.livePose());
+    if (toRoute && act.addToRoute) act.addToRoute({ x, y, yaw });
+    else act.sendGoal(x, y, yaw, 'map point');
   }
 
   canvas.addEventListener('pointerdown', (event) => {
@@ -97,8 +100,8 @@ export function attachInput(canvas, S, act) {
     restCursor();
     const [x, y] = local(event);
     if (!cancelled && gesture.kind === 'goal') {
-      sendGoalFrom(gesture.sx, gesture.sy, x, y);
-      act.setMode('pan');  // like RViz's goal tool: one goal, then back to moving the map
+      sendGoalFrom(gesture.sx, gesture.sy, x, y, event.shiftKey);
+      if (!event.shiftKey) act.setMode('pan');  // like RViz's goal tool: one goal, then back to moving the map
     } else if (!cancelled && gesture.kind === POSE_MODE) {
       act.setPose(gesture.sx, gesture.sy, x, y);
       act.setMode('pan');

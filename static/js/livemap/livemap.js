@@ -11,6 +11,8 @@ import { attachInput } from './input.js';
 import { follow, mapPageUrl, sendGoal } from './network.js';
 import { POSE_HINT, POSE_MODE, finishPoseGesture } from './initial_pose.js';
 import { createLayers } from './layers/layers.js';
+import { attachNav2 } from '../nav2/panel.js';
+import { drawNav2 } from '../nav2/draw.js';
 
 export { worldToPixel, pixelToWorld };
 
@@ -69,6 +71,7 @@ function draw() {
     dpr: window.devicePixelRatio || 1, plan: S.plan, waypoints: S.waypoints, goal: S.goal, pose: S.pose,
     poseStale: noPose(), preview: S.preview, botRadiusM: S.botRadiusM, keepOut: S.keepOut, layers,
   });
+  drawn.nav2 = drawNav2(ctx, (x, y) => worldToScreen(S.geometry, S.view, x, y), S);
   S.drawCount += 1;
   publish(root, S, drawn, noPose());
 }
@@ -119,7 +122,10 @@ function setMode(mode) {
   requestDraw();
 }
 
-const goal = (x, y, yaw, what) => sendGoal(S, x, y, yaw, what, requestDraw);
+const nav2 = attachNav2(S, { redraw: requestDraw, say });
+// NavigateToPose when the server says goals go there (ROVER_WEB_NAV2_GOAL_MODE), else the goal topic.
+const goal = (x, y, yaw, what) => (nav2.via() === 'action'
+  ? nav2.sendGoal(x, y, yaw, what) : sendGoal(S, x, y, yaw, what, requestDraw));
 
 window.liveMap = {
   worldToScreen: (x, y) => worldToScreen(S.geometry, S.view, x, y),
@@ -130,7 +136,7 @@ window.liveMap = {
 // --- wiring ---
 
 attachInput(canvas, S, {
-  viewport, redraw: requestDraw, setMode, stopTracking, sendGoal: goal,
+  viewport, redraw: requestDraw, setMode, stopTracking, sendGoal: goal, addToRoute: nav2.addToRoute,
   livePose: () => (S.pose && !noPose() ? S.pose : null),
   setPose: (sx, sy, ex, ey) => finishPoseGesture(S, sx, sy, ex, ey, S.pose, requestDraw),
 });
@@ -145,6 +151,12 @@ $('livemap-select').addEventListener('change', (event) => {
   const option = event.target.selectedOptions[0];
   if (option && option.dataset.page) window.location.assign(option.dataset.page);
 });
+for (const button of document.querySelectorAll('[data-route-add]')) {
+  button.addEventListener('click', () => {
+    const w = S.waypoints[Number(button.dataset.routeAdd)];
+    if (w) nav2.addToRoute(w);
+  });
+}
 for (const button of document.querySelectorAll('[data-waypoint]')) {
   button.addEventListener('click', () => {
     const w = S.waypoints[Number(button.dataset.waypoint)];
