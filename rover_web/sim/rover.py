@@ -47,6 +47,7 @@ from .frames import FramePublisher, Localisation
 from .geodesy import enu_to_geodetic
 from .health import HealthModel
 from .mission import MissionDriver
+from .model import DescriptionPublisher
 from .robots import SPACING_EAST_M
 from .walls import StallWatch, Walls
 
@@ -198,6 +199,7 @@ class RoverSim(Node):
         # it); an initial pose then moves map -> odom and odometry's position stays continuous (frames.py).
         self.localisation = Localisation((0.0, 0.0, 0.0))
         self.frames = FramePublisher(self, self.localisation)
+        self.description = DescriptionPublisher(self)  # the model the 3D view draws (model.py)
         self.last_stamp = self.get_clock().now().to_msg()  # of the latest odometry: the pose sensors use
         self.create_subscription(PoseStamped, goal_topic, self._on_goal, 10)
         self.mission = MissionDriver(self)
