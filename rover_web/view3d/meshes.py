@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 MESH_TYPES = {".stl": "model/stl", ".dae": "model/vnd.collada+xml", ".obj": "model/obj", ".mtl": "text/plain",
               ".png": "image/png", ".jpg": "image/jpeg", ".jpeg": "image/jpeg", ".tga": "image/x-tga"}
-_PACKAGE = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,99}$")  # REP 144's package names
+_PACKAGE = re.compile(r"\A[A-Za-z][A-Za-z0-9_]{0,99}\Z")  # REP 144's package names
 MAX_PATH = 1024
 
 

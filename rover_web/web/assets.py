@@ -49,7 +49,7 @@ _IMPORT = re.compile(r"""^[ \t]*(?:import|export)\b[^'";]*?\bfrom\s*(['"])(\.{1,
 _DYNAMIC = re.compile(r"""\bimport\(\s*(['"])(\.{1,2}/[^'"]+)\1\s*\)""")
 _MODULE_SCRIPT = re.compile(r"""<script type="module" src="([^"]+)"></script>""")
 # Compress what compresses; images, fonts and archives are compressed already.
-_COMPRESSIBLE = re.compile(r"\.(js|mjs|css|json|geojson|svg|html|txt|map|xml)$")
+_COMPRESSIBLE = re.compile(r"\.(js|mjs|css|json|geojson|svg|html|txt|map|xml)\Z")
 
 
 @dataclass

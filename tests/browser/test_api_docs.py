@@ -17,11 +17,31 @@ def test_the_api_page_renders_every_operation_under_the_policy(live_server, brow
         watch = PageWatch(page)
         response = page.goto(live_server.url + "/api/docs")
         assert "script-src 'self'" in response.headers["content-security-policy"]
-        page.wait_for_selector(".opblock-summary-path", timeout=15000)
-        paths = page.locator(".opblock .opblock-summary-path")
-        assert paths.count() == expected
-        assert page.locator(".opblock-summary-path[data-path='/api/estop']").count() == 2
-        assert page.locator(".opblock-post .opblock-summary-path[data-path='/api/estop']").count() == 1
+        # Sections start closed (over 120 operations open at once did not render): every tag is
+        # listed, and each section, opened on its own, shows every operation of its tag.
+        by_tag = {}
+        for item in document["paths"].values():
+            for op in item.values():
+                for tag in op.get("tags", []):
+                    by_tag[tag] = by_tag.get(tag, 0) + 1
+        page.wait_for_selector(".opblock-tag", timeout=15000)
+        shown = page.evaluate("[...document.querySelectorAll('.opblock-tag')].map(t => t.dataset.tag)")
+        assert sorted(shown) == sorted(by_tag)
+        rendered = 0
+        for tag, count in by_tag.items():
+            header = page.locator(f".opblock-tag[data-tag='{tag}']")
+            header.click()
+            section = page.locator(f".opblock-tag-section:has(.opblock-tag[data-tag='{tag}']) .opblock-summary-path")
+            page.wait_for_function("([t, n]) => document.querySelectorAll("
+                                   "`#operations-tag-${t} ~ div .opblock-summary-path, "
+                                   ".opblock-tag-section.is-open .opblock-summary-path`).length >= n",
+                                   arg=[tag, count], timeout=15000)
+            rendered += section.count()
+            if tag == "estop":
+                assert page.locator(".opblock-summary-path[data-path='/api/estop']").count() == 2
+                assert page.locator(".opblock-post .opblock-summary-path[data-path='/api/estop']").count() == 1
+            header.click()  # closed again: one section open at a time
+        assert rendered == expected
         refused = [m for m in watch.console_errors if "Content Security Policy" in m or "Refused to" in m]
         assert refused == [], refused
         assert watch.console_errors == [], watch.console_errors

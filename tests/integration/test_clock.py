@@ -100,6 +100,11 @@ WALL_CLOCK_ALLOWED = {
     "hub/stop_all.py": "when a stop-all was sent, shown to people",
     "recording/service.py": "a running recording's duration, from its start kept on disk across restarts",
     "recording/upload.py": "an upload's id and when it was uploaded, shown to people",
+    "hub/directory.py": "a summary's signed send time against the hub's clock (its clock window, issue 40), and "
+                        "when a state changed, shown to people; lost and forgotten use the monotonic clock",
+    "hub/history.py": "when each state change happened, kept on disk and shown to people",
+    "nav2/service.py": "when a goal was sent, ended or canceled and when a server's state was read, shown to people",
+    "view3d/service.py": "a poses frame's send time, read by a viewer in another process (its frame age)",
     "zenoh_link/signing.py": "a signed stop's and summary's time, checked on another machine (monotonic clocks are "
                              "each machine's own); lost and stale on the hub use the monotonic clock",
 }

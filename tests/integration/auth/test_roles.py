@@ -58,6 +58,10 @@ REQUESTS = [
     ("PUT", "/api/layouts/{layout}", LAYOUT, "operator", "/api/layouts/<int:layout_id>"),
     ("PUT", "/api/me/layout", {"id": 1}, "viewer", "/api/me/layout"),  # picking is not changing a layout
     ("DELETE", "/api/layouts/{layout}", None, "operator", "/api/layouts/<int:layout_id>"),
+    ("POST", "/api/nav2/goal", {"x": 0.0, "y": 0.0}, "operator", "/api/nav2/goal"),
+    ("POST", "/api/nav2/route", {"mode": "follow_waypoints", "poses": [{"x": 0.0, "y": 0.0}]}, "operator",
+     "/api/nav2/route"),
+    ("POST", "/api/nav2/cancel", {}, "operator", "/api/nav2/cancel"),
     ("POST", "/logout", {}, "viewer", "/logout"),
 ]
 # Routes whose success needs a ROS peer: for a caller who may use them, this answer (from the view,
@@ -77,6 +81,10 @@ ANSWERED_WITHOUT_A_PEER = {
     "/api/recordings/<recording_id>": (404, "not_found"),
     # An upload's body is the MCAP file (tests/integration/recording/test_upload.py): JSON is not one.
     "/api/recordings/upload": (422, "not_mcap"),
+    # Nav2's goals need its action servers (tests/integration/nav2/); cancelling needs a goal.
+    "/api/nav2/goal": (503, "no_nav2_server"),
+    "/api/nav2/route": (503, "no_nav2_server"),
+    "/api/nav2/cancel": (409, "no_goal"),
 }
 RANK = {None: -1, "viewer": 0, "operator": 1, "admin": 2}
 PUBLIC = {("POST", "/login"), ("POST", "/login/estop")}  # tests/integration/estop/test_estop_all.py

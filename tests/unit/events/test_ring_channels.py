@@ -28,6 +28,6 @@ def emitted_channels() -> set[str]:
 
 
 def test_the_pages_ring_channels_are_the_ones_the_server_emits_on():
-    source = (ROOT / "static" / "js" / "shared_stream.js").read_text()
+    source = (ROOT / "static" / "js" / "live" / "shared_stream.js").read_text()
     listed = re.search(r"RING_CHANNELS = new Set\(\[([^\]]*)\]\)", source).group(1)
     assert set(re.findall(r"'([a-z0-9_]+)'", listed)) == emitted_channels() == {"scan_code", "panel_log", "plot"}
