@@ -196,22 +196,23 @@ def test_a_hundred_robots_a_sortable_filterable_table_markers_apart_and_a_robot_
     page = strict_page
     try:
         page.goto(url + "/robots")
-        page.wait_for_function("document.querySelectorAll('#hub-table tbody tr[data-heard=\"live\"]').length === 101",
-                               timeout=15000)
+        page.wait_for_function(
+            "() => document.querySelectorAll('#hub-table tbody tr[data-heard=\"live\"]').length === 101",
+            timeout=15000)
         assert "101 robots: 101 live, 0 waiting, 0 lost" in page.inner_text("#hub-counts")
         # Sorted by battery: r99 (40.5 %) first, then ascending; again: descending.
         page.click("button.hub-sort[data-sort='battery']")
-        page.wait_for_function("document.querySelector('#hub-table tbody tr').dataset.robot === 'r99'")
+        page.wait_for_function("() => document.querySelector('#hub-table tbody tr').dataset.robot === 'r99'")
         page.click("button.hub-sort[data-sort='battery']")
-        page.wait_for_function("document.querySelector('#hub-table tbody tr').dataset.robot === 'r00'")
+        page.wait_for_function("() => document.querySelector('#hub-table tbody tr').dataset.robot === 'r00'")
         assert page.get_attribute("#hub-table th:has(button[data-sort='battery'])", "aria-sort") == "descending"
         page.fill("#hub-filter", "r07")
-        page.wait_for_function("document.querySelectorAll('#hub-table tbody tr').length === 1")
+        page.wait_for_function("() => document.querySelectorAll('#hub-table tbody tr').length === 1")
         assert page.locator("#hub-table tbody tr").get_attribute("data-robot") == "r07"
         assert "1 shown" in page.inner_text("#hub-counts")
         # Markers: 50 robots share one spot, and not one dot hides another.
         page.wait_for_selector("#hub-map[data-ready='yes']", timeout=10000)
-        page.wait_for_function("document.querySelectorAll('.fleet-marker').length === 100", timeout=10000)
+        page.wait_for_function("() => document.querySelectorAll('.fleet-marker').length === 100", timeout=10000)
         assert "fleet-crowded" in page.get_attribute("#hub-map", "class")
         boxes = page.evaluate("""() => [...document.querySelectorAll('.fleet-marker-dot')]
             .map((d) => d.getBoundingClientRect()).map((r) => [r.x, r.y, r.width, r.height])""")
