@@ -20,19 +20,14 @@ from .state import UnknownMap, goal_payload
 bp = Blueprint("livemap", __name__)
 
 
-@bp.errorhandler(UnknownMap)
-def unknown_map(exc: UnknownMap):
-    return error_response(404, "unknown_map", str(exc))
+def answer_map_errors(blueprint: Blueprint) -> None:
+    """A pose refused by a floorplan, answered the same by every blueprint that checks one (nav2's too)."""
+    blueprint.register_error_handler(UnknownMap, lambda exc: error_response(404, "unknown_map", str(exc)))
+    blueprint.register_error_handler(OutsideMap, lambda exc: error_response(400, "outside_map", str(exc)))
+    blueprint.register_error_handler(OutsideGeofence, outside_geofence_response)
 
 
-@bp.errorhandler(OutsideMap)
-def outside_map(exc: OutsideMap):
-    return error_response(400, "outside_map", str(exc))
-
-
-@bp.errorhandler(OutsideGeofence)
-def inside_keep_out(exc: OutsideGeofence):
-    return outside_geofence_response(exc)
+answer_map_errors(bp)
 
 
 @bp.errorhandler(ShuttingDown)

@@ -6,10 +6,10 @@ from flask import Blueprint, jsonify, request
 
 from rover_web.auth import on_revoke, signed_in_name
 from rover_web.core.state import current_feature
-from rover_web.geofence import OutsideGeofence, outside_geofence_response
+from rover_web.geofence import OutsideGeofence
 from rover_web.livemap.keep_out import check_goal
+from rover_web.livemap.routes import answer_map_errors
 from rover_web.livemap.service import LiveMapService, OutsideMap, check_on_map
-from rover_web.livemap.state import UnknownMap
 from rover_web.web.http import ApiError, error_response, json_body
 from rover_web.web.validate import InvalidInput, number, only_keys, text
 
@@ -40,19 +40,7 @@ def shutting_down(exc: ShuttingDown):
     return error_response(503, "shutting_down", str(exc))
 
 
-@bp.errorhandler(UnknownMap)
-def unknown_map(exc: UnknownMap):
-    return error_response(404, "unknown_map", str(exc))
-
-
-@bp.errorhandler(OutsideMap)
-def outside_map(exc: OutsideMap):
-    return error_response(400, "outside_map", str(exc))
-
-
-@bp.errorhandler(OutsideGeofence)
-def inside_keep_out(exc: OutsideGeofence):
-    return outside_geofence_response(exc)
+answer_map_errors(bp)  # a goal or route point off the map or in a keep-out area, as LiveMap answers it
 
 
 def _sender() -> str:

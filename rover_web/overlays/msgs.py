@@ -6,6 +6,7 @@ import numpy as np
 
 from rover_web.livemap.msgs import occupancy_grid
 from rover_web.ros.convert import stamp_to_float, yaw_from_quaternion
+from rover_web.ros.graph import deserializer  # noqa: F401  (the feature's subscriptions take it from here)
 
 from .bounds import FRAME_ID_MAX, MARKERS_MAX_COUNT, NS_MAX, TEXT_MAX
 from .costmap import Grid
@@ -17,16 +18,6 @@ MARKER_ARRAY = "visualization_msgs/msg/MarkerArray"
 POLYGON_STAMPED = "geometry_msgs/msg/PolygonStamped"
 AMCL_POSE = "geometry_msgs/msg/PoseWithCovarianceStamped"
 ODOMETRY = "nav_msgs/msg/Odometry"
-
-
-def deserializer(type_name: str):
-    """bytes -> the message, for a raw subscription whose length was checked first (bounds.py)."""
-    from rclpy.serialization import deserialize_message
-
-    from rover_web.ros.typesupport import message_class
-
-    cls = message_class(type_name)
-    return lambda raw: deserialize_message(raw, cls)
 
 
 def _yaw(q) -> float:

@@ -22,6 +22,18 @@ from .side_node import SideNode
 RETURN_CODES = {0: "canceled", 1: "rejected", 2: "no_goals", 3: "no_goals"}  # 2, 3: nothing to cancel
 
 
+def cancel_if_accepted(sending) -> None:
+    """When a send_goal_async future the caller stopped waiting for completes with an accepted goal,
+    cancel that goal: it would otherwise run with nobody watching it (the caller was told there
+    was no answer)."""
+    def done(future) -> None:
+        late = None if future.exception() else future.result()
+        if late is not None and late.accepted:
+            late.cancel_goal_async()
+
+    sending.add_done_callback(done)
+
+
 class GoalCanceller:
     def __init__(self, runtime, actions: list[str], namespace: str = ""):
         # In the robot's namespace: each robot's canceller is a node of its own name (/boat/rover_web_estop).

@@ -22,6 +22,7 @@ from rcl_interfaces.msg import Parameter as ParameterMsg
 from rcl_interfaces.msg import ParameterType, ParameterValue
 from rcl_interfaces.srv import DescribeParameters, GetParameters, ListParameters, SetParameters
 
+from .actions import cancel_if_accepted
 from .convert import message_to_dict
 from .side_node import SideNode
 
@@ -247,13 +248,7 @@ class AdminNode:
         try:
             handle = self._wait(sending, timeout_s, action)
         except NoAnswer:
-            # The caller is told 504; a goal accepted after that would run with nobody watching it.
-            def cancel_late(future) -> None:
-                late = future.result() if not future.exception() else None
-                if late is not None and late.accepted:
-                    late.cancel_goal_async()
-
-            sending.add_done_callback(cancel_late)
+            cancel_if_accepted(sending)
             self._side.wake()
             raise
         if not handle.accepted:

@@ -19,6 +19,7 @@ import uuid
 from collections.abc import Callable
 from typing import Any
 
+from .actions import cancel_if_accepted
 from .side_node import SideNode
 
 GOAL_STATUS = {0: "unknown", 1: "accepted", 2: "executing", 3: "canceling", 4: "succeeded", 5: "canceled",
@@ -76,13 +77,7 @@ class GoalClient:
         try:
             handle = self._wait(sending, timeout_s, name)
         except NoAnswer:
-            # The caller is told there was no answer; a goal accepted after that must not run unwatched.
-            def cancel_late(future) -> None:
-                late = None if future.exception() else future.result()
-                if late is not None and late.accepted:
-                    late.cancel_goal_async()
-
-            sending.add_done_callback(cancel_late)
+            cancel_if_accepted(sending)
             self._side.wake()
             raise
         if not handle.accepted:

@@ -7,18 +7,19 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 NAMES = ("default", "sensor_data", "latched", "command")
 
 
-def profile(name: str = "default", depth: int = 10) -> QoSProfile:
+def profile(name: str = "default", depth: int | None = None) -> QoSProfile:
+    """A named profile; `depth` overrides its history depth (10, or 1 for latched and command)."""
     if name == "default":
-        return QoSProfile(depth=depth, history=HistoryPolicy.KEEP_LAST,
+        return QoSProfile(depth=depth or 10, history=HistoryPolicy.KEEP_LAST,
                           reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE)
     if name == "sensor_data":
         return qos_profile_sensor_data
     if name == "latched":
         # map_server, amcl and friends publish transient-local: a late joiner still gets the last value.
-        return QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
+        return QoSProfile(depth=depth or 1, history=HistoryPolicy.KEEP_LAST,
                           reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
     if name == "command":
         # Commands are volatile on purpose: a late subscriber must never receive an old "take off".
-        return QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
+        return QoSProfile(depth=depth or 1, history=HistoryPolicy.KEEP_LAST,
                           reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE)
     raise ValueError(f"unknown QoS profile {name!r}; expected one of {', '.join(NAMES)}")

@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-
+from rover_web.ros import qos
 from rover_web.ros.typesupport import UnknownMessageType, message_class
 
 TF_MESSAGE = "tf2_msgs/msg/TFMessage"
@@ -14,10 +13,8 @@ HOW_TO_GET = ("source /opt/ros/jazzy/setup.bash before starting rover_web (a ROS
 # local, so a late joiner gets every static transform broadcast before it started (each static
 # broadcaster keeps one message with all of its transforms: depth 1 per publisher is enough, tf2 asks
 # for more to be safe).
-DYNAMIC_QOS = QoSProfile(depth=100, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE,
-                         durability=DurabilityPolicy.VOLATILE)
-STATIC_QOS = QoSProfile(depth=100, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE,
-                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
+DYNAMIC_QOS = qos.profile("default", depth=100)
+STATIC_QOS = qos.profile("latched", depth=100)
 
 
 def missing() -> str | None:

@@ -5,22 +5,13 @@ from __future__ import annotations
 
 from rover_web.overlays.bounds import FRAME_ID_MAX, MARKERS_MAX_COUNT, NS_MAX, TEXT_MAX
 from rover_web.ros.convert import stamp_to_float
+from rover_web.ros.graph import deserializer  # noqa: F401  (the feature's subscriptions take it from here)
 
 from . import cloud
 
 STRING = "std_msgs/msg/String"
 POINT_CLOUD2 = "sensor_msgs/msg/PointCloud2"
 MARKER_ARRAY = "visualization_msgs/msg/MarkerArray"
-
-
-def deserializer(type_name: str):
-    """bytes -> the message, for a raw subscription whose length was checked first (overlays/bounds.py)."""
-    from rclpy.serialization import deserialize_message
-
-    from rover_web.ros.typesupport import message_class
-
-    cls = message_class(type_name)
-    return lambda raw: deserialize_message(raw, cls)
 
 
 def description(msg) -> str:
