@@ -120,7 +120,9 @@ def test_driving_through_wifi_edge_with_the_camera_on(field, browser):
         # The e-stop, still holding the stick, with the video running: the robot stops.
         page.click("#estop-engage")
         peer.wait_for("/cmd_vel", lambda m: is_zero(m), timeout=5)
-        page.wait_for_selector("#estop[data-engaged='yes']", timeout=10000)
+        # The page shows "sending…" at once and the latch only once the server confirmed it: the
+        # click's frame may still be queued behind video on the link when a stale stick's zero lands.
+        page.wait_for_selector("#estop[data-engaged='yes'][data-unconfirmed='no']", timeout=10000)
         assert requests.get(server.url + "/api/estop", timeout=5).json()["engaged"] is True
         time.sleep(0.5)
         last = twists(peer)[-1]

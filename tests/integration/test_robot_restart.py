@@ -37,7 +37,10 @@ def test_a_killed_robot_process_stops_motion_and_everything_recovers_when_it_ret
     subscribe_cmd_vel(peer)
     warm_up(peer, url)
     wait_until(lambda: status(url)["robot_link"] == "ok", 30, "link ok with the simulator up")
-    camera = MjpegClient(f"{url}/stream?topic=/camera/image_raw&width=160", keep_frames=False)
+    # The type named: the camera may be discovered after the link is ok, and the stream then waits
+    # for it instead of answering 404 (a loaded machine's discovery took that long once).
+    camera = MjpegClient(f"{url}/stream?topic=/camera/image_raw&msg_type=sensor_msgs/msg/Image&width=160",
+                         keep_frames=False)
     stick = Stick(url)
     try:
         camera.wait_frames(3, timeout=20)
