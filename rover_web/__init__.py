@@ -86,6 +86,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         overlays,
         panels,
         plot,
+        prefs,
         recording,
         ros_admin,
         scan_the_code,
@@ -121,6 +122,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         graph = fleet.graph  # the graph-wide scope: the first robot when there is only one
         app.extensions[EXTENSION] = fleet.first
         auth.init_app(app, graph)  # first: every route after it is checked for sign-in and role
+        prefs.init_app(app, graph)  # each user's theme and language: every page is rendered in them
         estop.init_app(app, fleet)  # before every feature that moves the robot: they gate on it
         geofence.init_app(app, fleet)  # before waypoints and livemap: they check it before publishing
         tf.init_app(app, fleet)  # the frames: before livemap, overlays and GPS, which place things through it

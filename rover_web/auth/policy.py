@@ -34,10 +34,10 @@ PUBLIC_ENDPOINTS = frozenset({"auth.login_form", "auth.login", "estop.login_esto
 # camera.viewer_ack: a page watching MJPEG says what it has received (camera/acks.py); only watching.
 # hub.estop_all: the fleet hub's stop-all (rover_web/hub) only engages, as estop_all does on a robot.
 # layouts.choose_layout: which layout the caller's own dashboard shows (a viewer picks; only operators
-# and admins change layouts).
+# and admins change layouts). prefs.set_preferences: the caller's own theme and language.
 ANY_USER_ENDPOINTS = frozenset({"auth.logout", "auth.revoke_my_sessions", "estop.estop_set", "estop.estop_all",
                                 "estop.estop_form",
-                                "hub.estop_all", "layouts.choose_layout",
+                                "hub.estop_all", "layouts.choose_layout", "prefs.set_preferences",
                                 "camera_webrtc.whep_offer", "camera_webrtc.whep_end", "camera.viewer_ack"})
 ADMIN_ENDPOINT_PREFIX = "auth.admin_"
 # recording.delete_recording: a recording is the record of what happened; only an admin destroys it.

@@ -93,7 +93,7 @@ class FleetHub:
 
 def create(app: Flask, settings: dict, testing: bool) -> Flask:
     """Finish `app` as a hub: sign-in, the Zenoh session, the routes. ConfigError if it cannot serve."""
-    from rover_web import auth, basemap, metrics
+    from rover_web import auth, basemap, metrics, prefs
     from rover_web.storage.claim import claim
     from rover_web.storage.db import Database, database_path
 
@@ -136,6 +136,7 @@ def create(app: Flask, settings: dict, testing: bool) -> Flask:
         app.extensions[EXTENSION] = rover
         try:
             auth.init_app(app, rover)  # first: every route after it is checked for sign-in and role
+            prefs.init_app(app, rover)
             directory.listen(session)
             rover.every(SWEEP_S, hub.sweep, name="hub-sweep", immediately=True)
         except BaseException:

@@ -57,6 +57,7 @@ REQUESTS = [
     ("POST", "/api/layouts", LAYOUT, "operator", "/api/layouts"),
     ("PUT", "/api/layouts/{layout}", LAYOUT, "operator", "/api/layouts/<int:layout_id>"),
     ("PUT", "/api/me/layout", {"id": 1}, "viewer", "/api/me/layout"),  # picking is not changing a layout
+    ("PUT", "/api/me/preferences", {"theme": "daylight"}, "viewer", "/api/me/preferences"),  # one's own choices
     ("DELETE", "/api/layouts/{layout}", None, "operator", "/api/layouts/<int:layout_id>"),
     ("POST", "/api/nav2/goal", {"x": 0.0, "y": 0.0}, "operator", "/api/nav2/goal"),
     ("POST", "/api/nav2/route", {"mode": "follow_waypoints", "poses": [{"x": 0.0, "y": 0.0}]}, "operator",

@@ -1,0 +1,65 @@
+"""What a request's page is shown in: the user's saved choices over the browser's cookies.
+
+The cookies are the browser's own copy (the page writes them with localStorage): they let the
+server render the first byte in the right theme and language before any script runs. They are
+read, never trusted beyond the allowed values.
+"""
+
+from __future__ import annotations
+
+from flask import request
+
+from rover_web.auth.identity import signed_in_name
+from rover_web.core.state import NotSetUp, current_feature
+from rover_web.web.validate import InvalidInput
+
+from .store import PreferenceStore
+
+THEMES = ("auto", "dark", "daylight")
+# The shipped catalogues (translations/); "auto" is the browser's Accept-Language.
+LANGUAGES = ("auto", "en", "es", "ja")
+ALLOWED = {"theme": THEMES, "language": LANGUAGES}
+DEFAULTS = {"theme": "auto", "language": "auto"}
+COOKIES = {"theme": "rover_web_theme", "language": "rover_web_lang"}
+
+
+class PreferenceService:
+    def __init__(self, store: PreferenceStore):
+        self.store = store
+
+    def for_user(self, user: str | None) -> dict:
+        return self.store.get(user) if user else {}
+
+
+def check(body: dict) -> dict:
+    """The body's changes, or InvalidInput naming the field (nothing is saved then)."""
+    changes = {}
+    for key, value in body.items():
+        allowed = ALLOWED.get(key)
+        if allowed is None:
+            raise InvalidInput(f"unknown field {key!r}; allowed: {', '.join(ALLOWED)}", "unknown_field")
+        if not isinstance(value, str):
+            raise InvalidInput(f"'{key}' must be a string, one of: {', '.join(allowed)}", "bad_type")
+        if value not in allowed:
+            raise InvalidInput(f"'{key}' must be one of: {', '.join(allowed)} (not {value[:40]!r})", "bad_value")
+        changes[key] = value
+    return changes
+
+
+def from_cookies() -> dict:
+    chosen = {}
+    for key, cookie in COOKIES.items():
+        value = request.cookies.get(cookie)
+        if value in ALLOWED[key]:
+            chosen[key] = value
+    return chosen
+
+
+def effective() -> dict:
+    """The request's choices: defaults, under the browser's cookies, under the signed-in user's own."""
+    try:
+        service = current_feature(PreferenceService)
+    except NotSetUp:  # a page of an app without users (none so far); the browser's choices alone
+        service = None
+    saved = service.for_user(signed_in_name()) if service is not None else {}
+    return {**DEFAULTS, **from_cookies(), **saved}
