@@ -63,10 +63,12 @@ def _init_robot(rover: Rover) -> None:
             msgs.deserializer(msgs.OCCUPANCY_GRID), lambda m, t=topic: service.on_costmap(t, msgs.grid(m))),
             "latched", raw=True)
     if service.markers_topic:
+        # One reader shared with the 3D view (bounds.MARKERS_SHARED): each reader of its own reassembles
+        # a hostile array whole, so two cost twice its size before either could refuse it.
         runtime.subscribe(msgs.MARKER_ARRAY, service.markers_topic, bounded(
             service.counts["markers"], bounds.MARKERS_MAX_BYTES, msgs.deserializer(msgs.MARKER_ARRAY),
             lambda m: service.on_markers(msgs.markers(m), len(m.markers) - bounds.MARKERS_MAX_COUNT),
-            lambda: watching("markers") > 0), 10, raw=True)
+            lambda: watching("markers") > 0), bounds.MARKERS_DEPTH, **bounds.MARKERS_SHARED)
     if service.footprint_topic:
         runtime.subscribe(msgs.POLYGON_STAMPED, service.footprint_topic, bounded(
             service.counts["footprint"], bounds.FOOTPRINT_MAX_BYTES, msgs.deserializer(msgs.POLYGON_STAMPED),
