@@ -5,7 +5,8 @@ ROS: subscribes a sensor_msgs/LaserScan (ROVER_WEB_SCAN_TOPIC), nav_msgs/Occupan
 geometry_msgs/PolygonStamped footprint (ROVER_WEB_FOOTPRINT_TOPIC), each placed in the map through
 TF (rover_web/placement.py), and the AMCL pose (else TF's map -> base_link: the recent path, and the
 fallback's robot when TF does not know a message's frame).
-SSE: `scan`, `costmap`, `markers`, `footprint`, each rate-limited. HTTP: GET /api/overlays.
+SSE: `scan` (and `scan3d`, the 3D view's, with heights), `costmap`, `markers`, `footprint`, each
+rate-limited. HTTP: GET /api/overlays.
 Modules: service (the per-app object), scan (thinning), costmap (encoding), markers (the set),
 poses (pose history), counts, msgs, routes.
 """
@@ -55,7 +56,8 @@ def _init_robot(rover: Rover) -> None:
     if service.scan_topic:
         runtime.subscribe(msgs.LASER_SCAN, service.scan_topic, bounded(
             service.counts["scan"], bounds.SCAN_MAX_BYTES, msgs.deserializer(msgs.LASER_SCAN),
-            lambda m: service.on_scan(msgs.scan(m)), lambda: watching("scan") > 0), "sensor_data", raw=True)
+            lambda m: service.on_scan(msgs.scan(m)), lambda: watching("scan") + watching("scan3d") > 0), "sensor_data",
+            raw=True)
     for topic in service.costmap_topics:
         # Nav2 publishes its costmaps transient local: a page opened later still gets the global one.
         runtime.subscribe(msgs.OCCUPANCY_GRID, topic, bounded(
