@@ -28,8 +28,9 @@ FRAME_ID_MAX = 256  # a frame name; each marker carries its own into the frame s
 # whole in every reader before rmw can hand over its length, and rmw and rclpy then copy it twice
 # (FastBuffer, the serialized message, then Python's bytes: each step holds two copies at once). Two
 # readers cost a 46 MB array 135 MB at peak, one 92 MB (bench/hostile.py, BENCHMARKS.md 2026-11-29).
-# Shared raw, it is taken by the runtime's taker thread (ros/raw_taker.py), off the executor.
-MARKERS_SHARED = {"raw": True, "share": True}
+# Taken on the executor, as before (taker=False): converting an array of 1,000 markers for both is tens
+# of milliseconds, which on the runtime's taker thread would hold back /tf and /odom behind it.
+MARKERS_SHARED = {"raw": True, "share": True, "taker": False}
 MARKERS_DEPTH = 10  # arrays are deltas (add, delete): a burst must not lose any
 
 
