@@ -11,6 +11,7 @@ choice of decoding in the server's process rather than a worker (docs/security.m
 process costs to start and hold, against what a bounded read costs.
 
     .venv/bin/python bench/hostile.py [--quick]      # --quick: smaller bombs (still over every cap)
+    .venv/bin/python bench/hostile.py --markers-only # the marker array alone
 """
 
 from __future__ import annotations
@@ -235,9 +236,15 @@ def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--markers", type=int, default=200_000)
+    parser.add_argument("--markers-only", action="store_true", help="the marker array alone, not the files")
     args = parser.parse_args()
     print(machine(), "(shared with other sessions: figures from a loaded machine)")
     env = ros_env()
+    if args.markers_only:
+        markers = run_markers(env, args.markers)
+        ok = markers["rss_growth_mb"] < 100 and markers["estop_p99_ms"] < 50 and markers["cpu_after_pct"] < 10
+        print(json.dumps({"bench": "hostile_markers", "markers": markers, "markers_within_targets": ok}))
+        return
     with tempfile.TemporaryDirectory() as tmp:
         worker = worker_figures(Path(tmp))
     results = run_files(env, args.quick)

@@ -1,5 +1,6 @@
 """A separate rclpy process for bench/hostile.py: what the review's hostile DDS peer published, one
-MarkerArray of N zero-point cubes (default 200,000) on /visualization_marker_array, a few times."""
+MarkerArray of N zero-point cubes (default 200,000) on /visualization_marker_array, a few times
+(from several DDS writers at once with --writers)."""
 
 import argparse
 import time
@@ -15,11 +16,13 @@ def main() -> None:
     parser.add_argument("--markers", type=int, default=200_000)
     parser.add_argument("--times", type=int, default=3)
     parser.add_argument("--period", type=float, default=2.0)
+    parser.add_argument("--writers", type=int, default=1, help="DDS writers publishing it at once")
     args = parser.parse_args()
     context = Context()
     rclpy.init(context=context, signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node("bench_marker_flood", context=context)
-    pub = node.create_publisher(MarkerArray, "/visualization_marker_array", 10)
+    pubs = [node.create_publisher(MarkerArray, "/visualization_marker_array", 10) for _ in range(args.writers)]
+    pub = pubs[0]
     array = MarkerArray()
     for i in range(args.markers):
         m = Marker()
@@ -35,7 +38,8 @@ def main() -> None:
     time.sleep(0.5)
     print("publishing", flush=True)
     for _ in range(args.times):
-        pub.publish(array)
+        for each in pubs:
+            each.publish(array)
         time.sleep(args.period)
     node.destroy_node()
     context.try_shutdown()

@@ -32,6 +32,12 @@ MAPLIBRE_TGZ_SHA256="b84d7fdf7fba5922fd3fff9a92733936c7a03b99165afc6c84f41c311bd
 UPLOT_TGZ_SHA256="4b8a8191e425658e3ea8c8c1314b0fc679c861ee3a1af2b20c7b16ba50b5133d"
 SWAGGER_UI_TGZ_SHA256="1b8e891893404ea4c3558b6a87e2a3e494e7eedba41168c2ece5800a391a6ea6"
 GRIDSTACK_TGZ_SHA256="dad337eb31dccca66781783efaefd29a65a10fc067145607c95ff39a9e94a84b"
+# three's npm package ships no minified build (0.187.0's build/ has none) and urdf-loader has none:
+# their ES modules are minified here by esbuild (the minifier Vite uses), its Linux x64 binary from
+# npm, pinned. Its output is deterministic for a version, so the sums of the
+# minified files are pinned like any other.
+ESBUILD_VERSION="0.28.2"
+ESBUILD_TGZ_SHA256="9573bb2233aab0f9ea7647d5cca9726113cc1768de61d66b17267f4db84488f6"  # @esbuild/linux-x64
 THREE_TGZ_SHA256="ff540832ded0cfe919764d24a3d88f3e2a05f23303f876423e4f893841e90728"
 URDF_LOADER_TGZ_SHA256="19909aad681a1dfb5e4820aaf8369f6ff0837ae91dbb664f47895fe2d64f0b83"
 
@@ -65,26 +71,26 @@ GRIDSTACK_FILES=(
 )
 
 # The 3D view (docs/view3d.md): three.js's ES modules, the addons it needs, and urdf-loader. These are
-# ES modules that import the bare name 'three'; with no build step and no inline import map (the CSP
-# allows no inline script), rewrite_imports points those imports at the vendored files, relative, and
-# the sums below are of the rewritten files. Nothing else in them changes.
+# ES modules that import the bare name 'three'; rewrite_imports points those imports at the vendored
+# files, relative, and minify (esbuild, above) makes the .min.js each is served as, its relative imports
+# pointed at the other .min.js files and its @license comments kept; the sums below are of those files.
 THREE_FILES=(
-  "build/three.module.js                              three.module.js                      104f56145899722094556490d787aae0617cc2fc3382f31df02d724ea1aee341"
-  "build/three.core.js                                three.core.js                        613e370f76638fdef83926642bf256dc9615684922de1ce1f63a8583e5d78578"
+  "build/three.module.js                              three.module.min.js                  36dc3a9cfb7765751181533d6806dad99fa4ecbc894669351f693065d9f3cedc"
+  "build/three.core.js                                three.core.min.js                    04750c60541ce68acf84ea72bdaea4b2dc7696b0501d36faeaa9d1d0cc63ba78"
   "LICENSE                                            LICENSE                              8b378ebe60e2fe500158cb0ac71cb5e8b7d92953c2abcc63a0eb90499653b5bc"
-  "examples/jsm/controls/OrbitControls.js             addons/controls/OrbitControls.js     ab8eee754d1c92e54353ef104827d63eb716ca5ebe33797702091b48fa847c39"
-  "examples/jsm/loaders/STLLoader.js                  addons/loaders/STLLoader.js          8de70598b2bd4087228fd0b4d5269754137799f7f91ad83555c4892bd059bc84"
-  "examples/jsm/loaders/OBJLoader.js                  addons/loaders/OBJLoader.js          d542baa4980b1585edbd9aaa66683b03e01769343c1ba6cb6e2ca6ba5f16cf49"
-  "examples/jsm/loaders/TGALoader.js                  addons/loaders/TGALoader.js          4a071647c7e64f9b04baee94096986ae8cf44b98560411610e9bd548b6f42a3c"
-  "examples/jsm/loaders/ColladaLoader.js              addons/loaders/ColladaLoader.js      d723fbf61519548ef129974ff67f57a1cd3e95ec8bdcffa6d679f191fb7cd0c9"
-  "examples/jsm/loaders/collada/ColladaParser.js      addons/loaders/collada/ColladaParser.js   3318966a315b8174b5d92719808f71b6beaaef4c64db966d7721c4b7e47baf0d"
-  "examples/jsm/loaders/collada/ColladaComposer.js    addons/loaders/collada/ColladaComposer.js 9ada68b206798bcaee7879246a360ea4033795301091bd4d882936a63d766e6f"
+  "examples/jsm/controls/OrbitControls.js             addons/controls/OrbitControls.min.js d0eeeabe122b7ff6842304601e19699f3931b8eb3d94a8bb52e847a3eb6f921b"
+  "examples/jsm/loaders/STLLoader.js                  addons/loaders/STLLoader.min.js      02956604f598654cf6df628d0226561e9762ddbd437786d9cd3e4ec781c43353"
+  "examples/jsm/loaders/OBJLoader.js                  addons/loaders/OBJLoader.min.js      2a0ddd2f7230027510ce0300d0d0ec3e2a085b63c0e3b1b90a6117835829da4e"
+  "examples/jsm/loaders/TGALoader.js                  addons/loaders/TGALoader.min.js      0f0859dadfc6ea5b1753c8d6d985f9e5f13822ffb8d21741e65457c847b8f838"
+  "examples/jsm/loaders/ColladaLoader.js              addons/loaders/ColladaLoader.min.js  6b0a01936c039ed5e74078438aac7e8d3042a0d8e24ce56304bb686cb6fc2284"
+  "examples/jsm/loaders/collada/ColladaParser.js      addons/loaders/collada/ColladaParser.min.js   edc26b748a02788459744c3d7051e18f921cc7f08580040a018d35940b840f13"
+  "examples/jsm/loaders/collada/ColladaComposer.js    addons/loaders/collada/ColladaComposer.min.js 3f18c230de10ba8136af3f59306f371a269224363a4d5499d3aae49627db354d"
 )
 # urdf-loader's tarball carries no licence file; package.json says Apache-2.0, whose text is added from
 # Debian's /usr/share/common-licenses/Apache-2.0 (see static/vendor/README.md).
 URDF_LOADER_FILES=(
-  "src/URDFLoader.js    URDFLoader.js    c31491679e2fb5d47397af1aa5e4e0a6ab1d2be3f1b5d16725b731b6d9f25c8b"
-  "src/URDFClasses.js   URDFClasses.js   969a663f6b8fe9b4a370e679a2548929794fcb58c0fd614c864e60b8293aacd6"
+  "src/URDFLoader.js    URDFLoader.min.js    da097ac4c7e99d6a192d448ee755160f8718f07e3150326a4475dd61cabd9979"
+  "src/URDFClasses.js   URDFClasses.min.js   4fa65af7fa612935ec75596fded700a231fa23fa6474c2b182bf635343d2b733"
   "package.json         package.json     d4134ad13b0a5a1abd7ee1d6178c1f55dcfcfa0bf61b090e46620b5e05c27bb2"
 )
 
@@ -101,6 +107,28 @@ rewrite_imports() {
   case "$file" in *.js) ;; *) return 0 ;; esac
   if [[ "$name" == urdf-loader ]]; then three="${up}../three-$THREE_VERSION/"; else three="${up:-./}"; fi
   sed -i -E "s#from 'three'#from '${three}three.module.js'#; s#from 'three/examples/jsm/#from '${three}addons/#" "$file"
+}
+
+# minify FILE: esbuild's minified form of an ES module, in place; its relative imports (the vendored
+# modules beside it) point at their .min.js names.
+minify() {
+  local file="$1"
+  sed -i -E "s#(from '\.{1,2}/[^']*)\.js'#\1.min.js'#g" "$file"
+  "$ESBUILD" --minify --legal-comments=inline --charset=utf8 --log-level=warning "$file" --outfile="$file.min" \
+    || die "esbuild could not minify $file"
+  mv "$file.min" "$file"
+}
+
+# fetch_esbuild: the pinned esbuild binary (npm's @esbuild/linux-x64, its tarball's sum checked) in $TMP.
+fetch_esbuild() {
+  [[ "$(uname -s)-$(uname -m)" == Linux-x86_64 ]] || die "the pinned esbuild is Linux x86_64's (minify needs it)"
+  mkdir -p "$TMP/esbuild"
+  (cd "$TMP/esbuild" && npm pack --loglevel=error "@esbuild/linux-x64@$ESBUILD_VERSION" >/dev/null) \
+    || die "npm pack @esbuild/linux-x64@$ESBUILD_VERSION failed"
+  [[ "$(sha256_of "$TMP/esbuild/esbuild-linux-x64-$ESBUILD_VERSION.tgz")" == "$ESBUILD_TGZ_SHA256" ]] \
+    || die "tarball sha256 mismatch for @esbuild/linux-x64@$ESBUILD_VERSION"
+  tar -xzf "$TMP/esbuild/esbuild-linux-x64-$ESBUILD_VERSION.tgz" -C "$TMP/esbuild"
+  ESBUILD="$TMP/esbuild/package/bin/esbuild"
 }
 
 sha256_of() { sha256sum "$1" | cut -d' ' -f1; }
@@ -149,6 +177,7 @@ vendor_pkg() {
     mkdir -p "$(dirname "$work/stage/$dst")"
     install -m 0644 "$work/unpacked/package/$src" "$work/stage/$dst"
     if [[ "$name" == three || "$name" == urdf-loader ]]; then rewrite_imports "$work/stage/$dst" "$dst" "$name"; fi
+    if [[ "$dst" == *.min.js && "$src" != *.min.js ]]; then minify "$work/stage/$dst"; fi
   done
   verify_dir "$work/stage" "$@" || die "$name@$version: checksum verification failed, repo left untouched"
 
@@ -180,6 +209,7 @@ fi
 command -v npm >/dev/null || die "npm not found"
 TMP="$(mktemp -d "${TMPDIR:-/tmp}/rover-vendor.XXXXXX")"
 trap 'rm -rf "$TMP"' EXIT
+fetch_esbuild
 
 vendor_pkg nipplejs "$NIPPLEJS_VERSION" "$NIPPLEJS_TGZ_SHA256" "${NIPPLEJS_FILES[@]}"
 vendor_pkg maplibre-gl "$MAPLIBRE_VERSION" "$MAPLIBRE_TGZ_SHA256" "${MAPLIBRE_FILES[@]}"

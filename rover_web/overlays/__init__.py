@@ -5,7 +5,8 @@ ROS: subscribes a sensor_msgs/LaserScan (ROVER_WEB_SCAN_TOPIC), nav_msgs/Occupan
 geometry_msgs/PolygonStamped footprint (ROVER_WEB_FOOTPRINT_TOPIC), each placed in the map through
 TF (rover_web/placement.py), and the AMCL pose (else TF's map -> base_link: the recent path, and the
 fallback's robot when TF does not know a message's frame).
-SSE: `scan`, `costmap`, `markers`, `footprint`, each rate-limited. HTTP: GET /api/overlays.
+SSE: `scan` (and `scan3d`, the 3D view's, with heights), `costmap`, `markers`, `footprint`, each
+rate-limited. HTTP: GET /api/overlays.
 Modules: service (the per-app object), scan (thinning), costmap (encoding), markers (the set),
 poses (pose history), counts, msgs, routes.
 """
@@ -55,7 +56,8 @@ def _init_robot(rover: Rover) -> None:
     if service.scan_topic:
         runtime.subscribe(msgs.LASER_SCAN, service.scan_topic, bounded(
             service.counts["scan"], bounds.SCAN_MAX_BYTES, msgs.deserializer(msgs.LASER_SCAN),
-            lambda m: service.on_scan(msgs.scan(m)), lambda: watching("scan") > 0), "sensor_data", raw=True)
+            lambda m: service.on_scan(msgs.scan(m)), lambda: watching("scan") + watching("scan3d") > 0), "sensor_data",
+            raw=True)
     for topic in service.costmap_topics:
         # Nav2 publishes its costmaps transient local: a page opened later still gets the global one.
         runtime.subscribe(msgs.OCCUPANCY_GRID, topic, bounded(
@@ -63,10 +65,12 @@ def _init_robot(rover: Rover) -> None:
             msgs.deserializer(msgs.OCCUPANCY_GRID), lambda m, t=topic: service.on_costmap(t, msgs.grid(m))),
             "latched", raw=True)
     if service.markers_topic:
+        # One reader shared with the 3D view (bounds.MARKERS_SHARED): each reader of its own reassembles
+        # a hostile array whole, so two cost twice its size before either could refuse it.
         runtime.subscribe(msgs.MARKER_ARRAY, service.markers_topic, bounded(
             service.counts["markers"], bounds.MARKERS_MAX_BYTES, msgs.deserializer(msgs.MARKER_ARRAY),
             lambda m: service.on_markers(msgs.markers(m), len(m.markers) - bounds.MARKERS_MAX_COUNT),
-            lambda: watching("markers") > 0), 10, raw=True)
+            lambda: watching("markers") > 0), bounds.MARKERS_DEPTH, **bounds.MARKERS_SHARED)
     if service.footprint_topic:
         runtime.subscribe(msgs.POLYGON_STAMPED, service.footprint_topic, bounded(
             service.counts["footprint"], bounds.FOOTPRINT_MAX_BYTES, msgs.deserializer(msgs.POLYGON_STAMPED),

@@ -24,6 +24,14 @@ GRID_OVERHEAD_BYTES = 4 * KIB  # header, frame_id and MapMetaData around the cel
 NS_MAX = 64
 TEXT_MAX = 200
 FRAME_ID_MAX = 256  # a frame name; each marker carries its own into the frame sent to every page
+# The markers topic has one DDS reader for the overlays and the 3D view: Fast DDS reassembles a sample
+# whole in every reader before rmw can hand over its length, and rmw and rclpy then copy it twice
+# (FastBuffer, the serialized message, then Python's bytes: each step holds two copies at once). Two
+# readers cost a 46 MB array 135 MB at peak, one 92 MB (bench/hostile.py, BENCHMARKS.md 2026-11-29).
+# Taken on the executor, as before (taker=False): converting an array of 1,000 markers for both is tens
+# of milliseconds, which on the runtime's taker thread would hold back /tf and /odom behind it.
+MARKERS_SHARED = {"raw": True, "share": True, "taker": False}
+MARKERS_DEPTH = 10  # arrays are deltas (add, delete): a burst must not lose any
 
 
 def grid_max_bytes(max_cells: int) -> int:

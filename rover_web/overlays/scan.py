@@ -112,3 +112,10 @@ def payload(topic: str, scan: Scan, robot: tuple[float, float, float], points: n
     return {"topic": topic, "frame_id": scan.frame_id, "stamp": scan.stamp, "beams": int(len(scan.ranges)),
             "pose": [round(v, 4) for v in robot], "range_max": round(scan.range_max, 3),
             "points": np.round(points, 2).ravel().tolist(), "far_points": far, "placed_by": placed_by}
+
+
+def payload_3d(topic: str, scan: Scan, points: np.ndarray, placed_by: str) -> dict:
+    """The `scan3d` channel's value (the 3D view): every return drawn on the map, near and far, flat
+    [x0, y0, z0, x1, ...] in centimetre-rounded metres of the map frame, z included."""
+    return {"topic": topic, "frame_id": scan.frame_id, "stamp": scan.stamp, "placed_by": placed_by,
+            "points": np.round(points, 2).ravel().tolist()}

@@ -40,7 +40,7 @@ log = logging.getLogger(__name__)
 FOOTPRINT_MAX_HZ = 5.0
 COSTMAP_CHECK_S = 0.05  # how often the encoding loop looks for a new grid: the most it adds to a grid's age
 FOOTPRINT_MAX_POINTS = 200
-CHANNELS = ("scan", "costmap", "markers", "footprint")
+CHANNELS = ("scan", "scan3d", "costmap", "markers", "footprint")
 AMCL_QUIET_S = 2.0  # no AMCL pose this long: the robot's pose history is fed from TF's map -> base_link
 TF_POSE_S = 0.2  # how often then (the path keeps a point per 5 cm: 5 a second is plenty)
 
@@ -166,14 +166,19 @@ class OverlayService:
         far = self._place_returns(placement, thinned.far_angles, thinned.far_ranges)
         counts.send(placed_by)
         self.hub.publish_throttled("scan", scan.payload(self.scan_topic, value, heading(placement, 0.0, 0.0, 0.0),
-                                                        points, far, placed_by), self.scan_max_hz)
+                                                        points[:, :2], far[:, :2], placed_by), self.scan_max_hz)
+        if self.hub.watchers("scan3d") > 0:
+            # The 3D view's: the same returns with their height, where TF put the laser at the scan's stamp
+            # (a tilted laser's returns slope); placed by the configured offsets, they are at z = 0.
+            self.hub.publish_throttled("scan3d", scan.payload_3d(self.scan_topic, value, np.vstack((points, far)),
+                                                                 placed_by), self.scan_max_hz)
 
     @staticmethod
     def _place_returns(placement, angles, ranges):
-        """Returns in the laser's frame, placed in 3D (a tilted laser too), as (N, 2) map points."""
+        """Returns in the laser's frame, placed in 3D (a tilted laser too), as (N, 3) map points."""
         xs, ys = scan.in_sensor_frame(angles, ranges)
-        mx, my, _ = placement.apply_many(xs, ys, None)
-        return np.column_stack((mx, my))
+        mx, my, mz = placement.apply_many(xs, ys, None)
+        return np.column_stack((mx, my, mz))
 
     # --- costmaps ---
 

@@ -132,7 +132,8 @@ class RosRuntime:
                                           event_callbacks=PublisherEventCallbacks(use_default_callbacks=False))
 
     def subscribe(self, msg_type: str | type, topic: str, callback: Callable[[Any], None],
-                  qos: str | int = "default", *, track: bool = True, raw: bool = False, share: bool = False):
+                  qos: str | int = "default", *, track: bool = True, raw: bool = False, share: bool = False,
+                  taker: bool = True):
         """Subscribe with an exception-safe callback; `track` adds the topic to /api/status.
 
         `raw` hands the callback the serialized message (bytes) instead of deserializing it, for
@@ -142,7 +143,9 @@ class RosRuntime:
         such a subscription is never destroyed. A shared raw subscription (the high-rate topics
         the app reads at known offsets) is taken by a thread of its own, not the executor
         (raw_taker.py: the executor's per-message Python was most of what /odom cost); its
-        callbacks must be thread-safe, and it returns None.
+        callbacks must be thread-safe, and it returns None. `taker=False` keeps a shared raw subscription
+        on the executor: for a topic whose callbacks do heavy work now and then (a MarkerArray's
+        conversion), which on the taker thread would hold back /tf and /odom behind it.
         """
         cls = message_class(msg_type) if isinstance(msg_type, str) else msg_type
         if share:
@@ -173,7 +176,7 @@ class RosRuntime:
                 self.callback_errors += 1
                 log.exception("callback for %s failed", topic)
 
-        if share and raw:
+        if share and raw and taker:
             if self._taker is None:
                 self._taker = RawTaker(self, "shared", node=self.node)
             self._taker.subscribe(cls, topic, lambda data, _received_ns: guarded(data), self._qos(qos))

@@ -17,7 +17,7 @@ import logging
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
 from rover_web.i18n import N_
-from rover_web.overlays.bounds import MARKERS_MAX_BYTES, bounded
+from rover_web.overlays.bounds import MARKERS_DEPTH, MARKERS_MAX_BYTES, MARKERS_SHARED, bounded
 from rover_web.tf import TfService
 
 from . import msgs, routes
@@ -59,11 +59,12 @@ def _init_robot(rover: Rover) -> None:
             service.cloud_bound, CLOUD_MAX_BYTES, msgs.deserializer(msgs.POINT_CLOUD2),
             lambda m: service.on_cloud(lambda: msgs.point_cloud(m)), service.cloud_watched), "sensor_data", raw=True)
     if service.markers_topic:
-        # A subscription of its own beside the overlays' (theirs keeps x, y and yaw only), deserialized
-        # only while a 3D view is open.
+        # The overlays' reader, shared (bounds.MARKERS_SHARED: one DDS reader reassembles each array, not
+        # two), with a callback of its own (theirs keeps x, y and yaw only), deserialized only while a
+        # 3D view is open.
         runtime.subscribe(msgs.MARKER_ARRAY, service.markers_topic, bounded(
             service.markers_bound, MARKERS_MAX_BYTES, msgs.deserializer(msgs.MARKER_ARRAY),
             lambda m: service.on_markers(msgs.markers(m)), lambda: hub.watchers("view3d_markers") > 0),
-            10, raw=True, track=not runtime.tracks(service.markers_topic))
+            MARKERS_DEPTH, track=not runtime.tracks(service.markers_topic), **MARKERS_SHARED)
         rover.every(MARKER_EXPIRY_S, service.expire_markers, name="view3d-marker-expiry")
     rover.every(1.0 / service.pose_hz, service.tick, name="view3d-poses")

@@ -1,10 +1,13 @@
 """visualization_msgs markers kept in 3D, as RViz keeps them: added or replaced by (ns, id), removed by
-DELETE, all by DELETEALL, gone when their lifetime runs out. Each keeps its own frame; the page places
-it through the frame's pose in the base frame (poses.py). Pure."""
+DELETE, all by DELETEALL, gone when their lifetime runs out. Each keeps its own frame and, as tf2 and
+RViz place a marker, where that frame was at the marker's stamp (`at_stamp`: its pose in each fixed
+frame the page offers, from a `place(frame, stamp)` the service gives); a marker stamped 0 or
+`frame_locked` has none, and the page places it with its frame's latest pose (poses.py). Pure."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 KINDS = {0: "arrow", 1: "cube", 2: "sphere", 3: "cylinder", 4: "line_strip", 5: "line_list", 6: "cube_list",
          7: "sphere_list", 8: "points", 9: "text", 10: "mesh", 11: "triangle_list"}
@@ -21,7 +24,9 @@ class Markers3d:
         self._markers: dict[tuple[str, int], dict] = {}
         self._expiry: dict[tuple[str, int], float] = {}
 
-    def apply(self, marker: dict, now: float) -> None:
+    def apply(self, marker: dict, now: float, place: Callable[[str, float], dict] | None = None) -> None:
+        """`place(frame, stamp)`: the frame's pose at the stamp in each fixed frame ({} when TF cannot
+        say yet: the page's latest pose), or BadMarker (tf2 refused the stamp: the marker is not kept)."""
         key = (marker["ns"], marker["id"])
         if marker["action"] == DELETEALL:
             self._markers.clear()
@@ -45,6 +50,11 @@ class Markers3d:
             raise BadMarker("too_many_markers")
         kept = {k: marker[k] for k in ("ns", "id", "frame_id", "pose", "scale", "color", "points", "colors", "text")}
         kept["kind"] = KINDS[marker["type"]]
+        stamp = marker.get("stamp", 0.0)
+        if place is not None and stamp > 0 and not marker.get("frame_locked", False):
+            at_stamp = place(marker["frame_id"], stamp)
+            if at_stamp:
+                kept["at_stamp"] = at_stamp
         if marker["type"] == 10:
             kept["mesh"] = marker["mesh_resource"]
         self._markers[key] = kept

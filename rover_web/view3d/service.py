@@ -9,10 +9,12 @@ that viewers fetch (routes.py), markers on the `view3d_markers` channel.
 from __future__ import annotations
 
 import logging
+import math
 import threading
 import time
 
 from rover_web.core.state import Rover
+from rover_web.placement import MapPlacer, Unplaceable
 
 from . import cloud, poses
 from .markers import BadMarker, Markers3d
@@ -233,15 +235,50 @@ class View3dService:
 
     def on_markers(self, markers: list[dict]) -> None:
         now = time.monotonic()
+        lookups: dict[tuple[str, float], dict | BadMarker] = {}  # one set of lookups per frame and stamp of the array
+
+        def place(frame: str, stamp: float) -> dict:
+            key = (frame, stamp)
+            if key not in lookups:
+                try:
+                    lookups[key] = self._marker_at(frame, stamp)
+                except BadMarker as exc:
+                    lookups[key] = exc
+            found = lookups[key]
+            if isinstance(found, BadMarker):
+                raise found
+            return found
+
         with self._markers_lock:
             for marker in markers:
                 try:
-                    self._markers.apply(marker, now)
+                    self._markers.apply(marker, now, place if self.tf is not None else None)
                 except BadMarker as exc:
                     reason = str(exc)
                     self.markers_skipped[reason] = self.markers_skipped.get(reason, 0) + 1
             payload = self._markers.payload()
         self.hub.publish_throttled("view3d_markers", {"markers": payload}, MARKERS_MAX_HZ)
+
+    def _marker_at(self, frame: str, stamp: float) -> dict:
+        """A marker's frame at its stamp in each fixed frame, as tf2 would place it (interpolated; a stamp
+        a little ahead of the newest transform takes the newest, placement.py); {} while TF has not
+        heard of the frame (the page then uses its latest pose, once there is one); BadMarker
+        ("tf_extrapolation_past", ...) when TF knows the frame but not at that time, as RViz refuses it."""
+        at: dict[str, list[float]] = {}
+        refused = None
+        for fixed in {self.map_frame, self.odom_frame, self.base_frame}:
+            try:
+                t = MapPlacer(self.tf, fixed).lookup(frame, stamp)
+            except Unplaceable as exc:
+                refused = str(exc)
+                continue
+            if t is not None:
+                values = (*t.translation, *t.rotation)
+                if all(math.isfinite(v) for v in values):
+                    at[fixed] = [round(float(v), 6) for v in values]
+        if not at and refused:
+            raise BadMarker(refused)
+        return at
 
     def expire_markers(self) -> None:
         with self._markers_lock:

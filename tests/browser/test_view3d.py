@@ -261,6 +261,45 @@ def test_the_dashboard_card_draws_the_model_and_stops_while_hidden(live_server_f
     assert page.watch.console_errors == []
 
 
+def test_a_marker_is_drawn_where_its_frame_was_at_its_stamp(scene, page):
+    """tf2's and RViz's placement: a cube stamped a second ago in base_link stays where base_link was
+    then while the robot drives on; the same cube frame_locked rides with base_link, red over green."""
+    server, urdf = scene
+    look_down(page, urdf, 0.0)
+    urdf.peer.advertise("/visualization_marker_array", MARKERS, qos=10)
+    urdf.peer.wait_match("/visualization_marker_array")
+    then = time.time() - 1.0
+
+    def cube(mid, rgb, frame_locked):
+        m = marker(1, mid, (0, -1), rgb, frame_locked=frame_locked)  # 1 m right of base_link: clear of the model
+        m["header"] = {"frame_id": "base_link", "stamp": stamp(then)}
+        return m
+
+    def holders():
+        now = time.time()
+        urdf.peer.publish("/tf", {"transforms": [transform("odom", "base_link", (*BASE_IN_ODOM, 0), t=then),
+                                                 transform("base_link", "arm", (0, 0, 0.15), t=then)]})
+        urdf.peer.publish("/tf", {"transforms": [transform("odom", "base_link", (5.0, -2.0, 0), t=now),
+                                                 transform("base_link", "arm", (0, 0, 0.15), t=now)]})
+        urdf.peer.publish("/visualization_marker_array", {"markers": [cube(1, (0, 1, 0), False),
+                                                                      cube(2, (1, 0, 0), True)]})
+        return page.evaluate("""() => Object.fromEntries(document.getElementById('view3d').view3d.layers.markers.items
+            .filter((i) => i.holder.visible).map((i) => [i.holder.userData.id, [i.holder.matrix.elements[12],
+                                                                                i.holder.matrix.elements[13]]]))""")
+    placed = wait_until(lambda: (h := holders()) and len(h) == 2 and h["2"][0] > 4.9 and h, 15,
+                        "both cubes placed, the frame-locked one with the robot's latest pose", interval=0.3)
+    assert placed["1"] == pytest.approx(list(BASE_IN_ODOM), abs=1e-3)  # where base_link was at the stamp
+    assert placed["2"] == pytest.approx([5.0, -2.0], abs=1e-3)          # frame_locked: where it is now
+    page.evaluate("""() => { const v = document.getElementById('view3d').view3d;
+                             v.camera.position.set(3.5, -1.5, 12); v.controls.target.set(3.5, -1.5, 0);
+                             v.controls.update(); v.requestDraw(); }""")
+    time.sleep(0.5)
+    image = canvas_image(page)
+    assert colour_at(page, image, BASE_IN_ODOM[0], BASE_IN_ODOM[1] - 1, 0.3) == "green"
+    assert colour_at(page, image, 5.0, -3.0, 0.3) == "red"
+    assert page.watch.console_errors == []
+
+
 def test_livemap_overlays_in_3d_in_the_map_frame(live_server_factory, ros_peer, page, tmp_path, monkeypatch):
     """The scan, a costmap and the plan the overlays already send, drawn on the ground where the map
     frame is (map -> odom from TF), from the same channels LiveMap reads."""

@@ -59,3 +59,40 @@ def test_a_shared_raw_subscription_is_taken_off_the_executor_and_serves_every_re
     peer.publish("/shared_odom", odom(99.0))
     time.sleep(0.3)
     assert len(got["a"]) == before  # nothing after the stop
+
+
+def test_a_shared_raw_subscription_can_stay_on_the_executor(ros_peer):
+    """taker=False (the markers: heavy callbacks now and then): one subscription, on the executor, for both."""
+    runtime = RosRuntime("shared_executor_test")
+    runtime.start()
+    got: dict[str, list] = {"a": [], "b": []}
+    threads = set()
+
+    def reader(name):
+        def on_raw(raw: bytes) -> None:
+            threads.add(threading.current_thread().name)
+            got[name].append(raw)
+        return on_raw
+
+    try:
+        runtime.subscribe(ODOM, "/shared_slow", reader("a"), qos=10, raw=True, share=True, taker=False)
+        runtime.subscribe(ODOM, "/shared_slow", reader("b"), qos=10, raw=True, share=True, taker=False)
+        assert [s.topic_name for s in runtime.node.subscriptions].count("/shared_slow") == 1
+        peer = ros_peer("shared_slow_publisher")
+        peer.advertise("/shared_slow", ODOM, qos=10)
+        peer.wait_match("/shared_slow")
+        assert peer.graph(["/shared_slow"])["subscribers"]["/shared_slow"] == 1  # one DDS reader for both
+        x = 0.0
+
+        def some_arrived():
+            nonlocal x
+            x += 1.0
+            peer.publish("/shared_slow", odom(x))
+            return got["a"] and got["b"]
+
+        wait_until(some_arrived, 10, "the shared subscription's messages")
+        time.sleep(0.2)
+        assert got["a"] == got["b"] and all(isinstance(raw, bytes) for raw in got["a"])
+        assert "ros-shared-taker" not in threads
+    finally:
+        runtime.stop()

@@ -1,6 +1,8 @@
-// visualization_msgs markers in 3D (the `view3d_markers` channel): each in its own frame, placed through TF.
+// visualization_msgs markers in 3D (the `view3d_markers` channel): each in its own frame, placed through TF
+// at its stamp.
 import * as THREE from './three.js';
 import { disposeTree, textSprite } from './labels.js';
+import { matrixOf } from './poses.js';
 
 const v3 = (p) => new THREE.Vector3(p[0], p[1], p[2]);
 
@@ -127,14 +129,19 @@ export class MarkerLayer {
       holder.add(pose);
       holder.userData = { ns: m.ns, id: m.id, kind: m.kind };
       this.group.add(holder);
-      this.items.push({ holder, frame: m.frame_id });
+      this.items.push({ holder, frame: m.frame_id, atStamp: m.at_stamp || null });
     }
   }
 
+  // As tf2 and RViz place a marker: where its frame was at its stamp (at_stamp, from the server); a marker
+  // stamped 0 or frame_locked follows its frame's latest pose. One the server placed at its stamp but not
+  // in this fixed frame (TF could not join them then) is not drawn.
   place(poses) {
     const fixedInverse = poses.fixedInverse();
-    for (const { holder, frame } of this.items) {
-      const m = poses.inFixed(frame || poses.fixedName(), fixedInverse);
+    for (const { holder, frame, atStamp } of this.items) {
+      const stamped = atStamp?.[poses.fixedName()];
+      const m = atStamp ? (stamped ? matrixOf(stamped) : null)
+        : poses.inFixed(frame || poses.fixedName(), fixedInverse);
       holder.visible = Boolean(m);
       if (m) { holder.matrix.copy(m); holder.matrixWorldNeedsUpdate = true; }
     }

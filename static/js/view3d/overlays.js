@@ -1,6 +1,6 @@
-// What LiveMap's overlays already send, drawn in 3D from the same channels (no second subscription on the
-// server): the laser scan, costmaps and the live occupancy grid as textured ground planes, and the Nav2
-// plan, all in the map frame; the GPS track in local east-north-up metres around its first fix.
+// What LiveMap's overlays already send, drawn in 3D from the same subscriptions on the server: the laser
+// scan (its own `scan3d` channel: the same returns with heights), costmaps and the live occupancy grid as
+// textured ground planes, and the Nav2 plan, all in the map frame; the GPS track in local east-north-up metres around its first fix.
 import * as THREE from './three.js';
 import { at } from '../core/api.js';
 import { on } from '../live/live.js';
@@ -40,7 +40,7 @@ export class Overlays {
     this.gpsAnchor = null;
     this.costmaps = new Map();
     this.gridVersion = null;
-    on('scan', (d) => this.scan(d));
+    on('scan3d', (d) => this.scan(d));
     on('costmap', (d) => this.costmap(d));
     on('plan', (d) => this.plan(d));
     on('live_map', (d) => this.grid(d));
@@ -53,14 +53,11 @@ export class Overlays {
     this.requestDraw();
   }
 
+  // The `scan3d` channel: the returns in the map frame with their heights, placed by the server through TF
+  // at the scan's stamp (a tilted laser's returns slope, a laser 40 cm up draws 40 cm up).
   scan(d) {
-    const flat = d.points || [];
-    const positions = new Float32Array(flat.length / 2 * 3);
-    for (let i = 0, j = 0; i < flat.length; i += 2, j += 3) {
-      positions[j] = flat[i]; positions[j + 1] = flat[i + 1]; positions[j + 2] = 0.1;  // a 2D scan: drawn 10 cm up
-    }
     const geometry = new THREE.BufferGeometry();
-    geometry.setAttribute('position', new THREE.BufferAttribute(positions, 3));
+    geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(d.points || []), 3));
     this.replace(this.groups.scan, new THREE.Points(geometry,
       new THREE.PointsMaterial({ color: 0xff3b30, size: 4, sizeAttenuation: false })));
   }

@@ -120,6 +120,20 @@ def test_a_pitched_laser_s_returns_are_projected_in_3d(live_server, tf_peer, sse
     assert event["points"] == pytest.approx([-0.2 - 2 * math.cos(math.pi / 6), 5.0], abs=0.01)
 
 
+def test_the_3d_view_s_scan_keeps_the_laser_s_height_and_tilt(live_server, tf_peer, sse_client):
+    stream = sse_client(live_server.url + "/api/events?channels=scan3d")
+    t0 = time.time() - 2.0
+    event = publish_until(tf_peer, "/scan", wall_scan("pitched", t0, [0.0, 0.1], [2.0, float("nan")]), stream,
+                          "scan3d", lambda d: d["frame_id"] == "pitched", t0)
+    # 0.4 m up, pitched 30° down: the return 2·cos 30° ahead and 2·sin 30° below the laser, in 3D.
+    assert event["placed_by"] == "tf"
+    assert event["points"] == pytest.approx([-0.2 - 2 * math.cos(math.pi / 6), 5.0, 0.4 - 2 * math.sin(math.pi / 6)],
+                                            abs=0.01)
+    flat = publish_until(tf_peer, "/scan", wall_scan("flipped", t0, [0.5, 0.6], [2.0, 2.0]), stream, "scan3d",
+                         lambda d: d["frame_id"] == "flipped", t0)
+    assert np.array(flat["points"]).reshape(-1, 3)[:, 2] == pytest.approx([0.25, 0.25], abs=0.01)  # its height
+
+
 def test_a_marker_in_the_laser_s_frame_and_a_footprint_in_base_link_follow_tf(live_server, tf_peer, sse_client):
     stream = sse_client(live_server.url + "/api/events?channels=markers,footprint")
     t0 = time.time() - 2.0

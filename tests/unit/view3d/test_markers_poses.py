@@ -60,3 +60,24 @@ def test_every_frame_in_the_base_frame():
     assert found["odom"][:3] == pytest.approx([-2, 1, 0], abs=1e-6)
     assert found["map"][:3] == pytest.approx([-2, 11, 0], abs=1e-6)
     assert found["island"] is None and found["rock"] is None  # another tree: TF cannot place them
+
+
+def test_a_marker_keeps_where_its_frame_was_at_its_stamp_unless_stamped_0_or_frame_locked():
+    asked = []
+
+    def place(frame, stamp):
+        asked.append((frame, stamp))
+        if stamp < 5:
+            raise BadMarker("tf_extrapolation_past")
+        return {"map": [1.0, 2.0, 0.0, 0.0, 0.0, 0.0, 1.0]}
+
+    kept = Markers3d()
+    kept.apply(marker(1, stamp=10.0, frame_id="base_link"), 0.0, place)
+    kept.apply(marker(2, stamp=0.0, frame_id="base_link"), 0.0, place)
+    kept.apply(marker(3, stamp=10.0, frame_id="base_link", frame_locked=True), 0.0, place)
+    with pytest.raises(BadMarker, match="tf_extrapolation_past"):
+        kept.apply(marker(4, stamp=1.0, frame_id="base_link"), 0.0, place)
+    by_id = {m["id"]: m for m in kept.payload()}
+    assert by_id[1]["at_stamp"] == {"map": [1.0, 2.0, 0.0, 0.0, 0.0, 0.0, 1.0]}
+    assert "at_stamp" not in by_id[2] and "at_stamp" not in by_id[3] and 4 not in by_id
+    assert asked == [("base_link", 10.0), ("base_link", 1.0)]  # stamp 0 and frame_locked: never looked up
