@@ -58,6 +58,8 @@ PAGES = {
     "plot": "/plot?topic=/odom&field=twist.twist.linear.x",
     "recordings": "/recordings",
 }
+FILES = re.compile(r"^https?://[^/]+/(static|tiles|basemap)/")  # what "whole" waits for, as COLLECT
+QUIET_S = 1.0  # nothing more asked for this long after the first event: the page is whole
 KEYS = ("bytes", "wire_bytes", "requests", "ttfb_ms", "estop_ms", "live_ms", "whole_ms", "floor_ms", "dcl_ms")
 
 # Runs before any of the page's scripts, in every document of the context.
@@ -102,9 +104,15 @@ class NetLog:
         cdp.on("Network.requestServedFromCache", lambda e: self.cached.add(e["requestId"]))
         cdp.on("Network.loadingFinished", lambda e: self.finished.__setitem__(e["requestId"], e["encodedDataLength"]))
         cdp.on("Network.responseReceived", self._response)
+        cdp.on("Network.loadingFailed", lambda e: self.finished.__setitem__(e["requestId"], 0))
 
     def reset(self):
         self.sent, self.cached, self.finished, self.streams = {}, set(), {}, set()
+
+    def pending_files(self) -> list[str]:
+        """Static files, tiles and basemaps asked for and not yet arrived (nor failed, nor cached)."""
+        return [url for rid, url in self.sent.items() if FILES.search(url)
+                and rid not in self.finished and rid not in self.cached]
 
     def _sent(self, e):
         if e["request"]["url"].startswith("http"):
@@ -165,10 +173,18 @@ def measure(page, net: NetLog, emu: LinkEmulator, link, go, timeout_s: float) ->
     go()
     page.wait_for_function("() => window.__pl && window.__pl.live !== null && document.readyState === 'complete'",
                            timeout=timeout_s * 1000)
-    try:
-        page.wait_for_load_state("networkidle", timeout=timeout_s * 1000)
-    except Exception:  # noqa: BLE001 - a page that polls may never be idle; what it fetched is measured all the same
-        pass
+    # Then every file the page asks for, the libraries it starts on its first event included, has
+    # arrived and nothing more came for a moment. Not Playwright's "networkidle": that also counts a
+    # quiet moment before the first event (a bundled page reaches one), after which MapLibre was missed.
+    deadline, quiet_since = time.monotonic() + timeout_s, None
+    while time.monotonic() < deadline:
+        if net.pending_files():
+            quiet_since = None
+        elif quiet_since is None:
+            quiet_since = time.monotonic()
+        elif time.monotonic() - quiet_since >= QUIET_S:
+            break
+        page.wait_for_timeout(50)  # the browser's events keep coming meanwhile
     got = page.evaluate(COLLECT)
     wire = emu.counters()["down"]["bytes_passed"] - down_before
     body, count, urls = net.figures()

@@ -155,6 +155,8 @@ class Bundles:
             target = os.path.normpath(os.path.join(JS_BUNDLES, spec)).replace(os.sep, "/")
             if not spec.startswith(".") or target not in self.hashed:
                 raise ValueError(f"the bundle of {entries[0]}... imports {spec!r}, not a file of static/")
+        if b"import.meta" in code:  # a module's own URL would be the bundle's: its relative URLs would miss
+            raise ValueError(f"a module of {', '.join(entries)} uses import.meta")
         name = f"{JS_BUNDLES}/{_digest(code)}.js"
         self._store(name + ".map", source_map)
         self._store(name, code + f"//# sourceMappingURL={name.rsplit('/', 1)[1]}.map\n".encode())

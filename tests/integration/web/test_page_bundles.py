@@ -116,6 +116,7 @@ def test_a_changed_module_changes_the_bundle_and_its_url(tmp_path):
 def test_what_cannot_be_bundled_is_served_one_by_one(tmp_path):
     static = _tree(tmp_path, {
         "js/page/a.js": "import '../page/missing.js';\n",
+        "js/page/b.js": "window.here = new URL('./data.json', import.meta.url);\n",
         "css/a.css": "a { color: red; }\n",
         "css/b.css": "b { color: blue; }\n",
         "css/c.css": "c { background: url(img/x.png); }\n",
@@ -123,6 +124,7 @@ def test_what_cannot_be_bundled_is_served_one_by_one(tmp_path):
     })
     _, bundles = _bundles(static, tmp_path / "store", [])
     assert bundles.scripts(["js/page/a.js"]) is None  # esbuild refused it: the page keeps its script tags
+    assert bundles.scripts(["js/page/b.js"]) is None  # its own URL would be the bundle's
     name, joined = bundles.styles(["css/a.css", "css/c.css", "css/b.css", "css/d.css"])
     assert joined == ["css/a.css", "css/b.css", "css/d.css"]  # a relative url() would point elsewhere
     assert name.startswith("css/bundle/")
