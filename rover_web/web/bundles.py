@@ -26,6 +26,7 @@ modules up front as before (assets.py): slower on a slow link, the same page.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import logging
@@ -85,10 +86,14 @@ class Bundles:
 
     def styles(self, sheets: list[str]) -> tuple[str | None, list[str]]:
         """(one stylesheet for those that can be joined, or None; the ones joined, in order)."""
-        joinable = [s for s in sheets if s in self.hashed and not _UNBUNDLABLE_CSS.search(self._text(s))]
+        joinable = [s for s in sheets if self._joinable(s)]
         if len(joinable) < 2:
             return None, []
         return self._once(("css",) + tuple(joinable), lambda: self._make_styles(joinable)), joinable
+
+    @functools.cache  # noqa: B019 - one per app, static/ as it was at start
+    def _joinable(self, sheet: str) -> bool:
+        return sheet in self.hashed and not _UNBUNDLABLE_CSS.search(self._text(sheet))
 
     def _text(self, name: str) -> str:
         return (self.static_dir / name).read_text(encoding="utf-8", errors="replace")
