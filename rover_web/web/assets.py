@@ -225,7 +225,7 @@ def init_app(app: Flask) -> None:
         if esbuild is None:
             log.warning("esbuild not found (scripts/bootstrap.sh installs it into .tools/): each page's modules "
                         "are served one by one, named up front; slower on a slow link (docs/page_load.md)")
-        bundles = Bundles(static_dir, build_dir, manifest.hashed, manifest.closure, serve, esbuild)
+        bundles = Bundles(static_dir, build_dir, manifest.hashed, serve, esbuild)
 
     @app.url_defaults
     def _hashed_static(endpoint, values):

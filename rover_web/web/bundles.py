@@ -48,6 +48,7 @@ JS_BUNDLES = "js/bundle"
 CSS_BUNDLES = "css/bundle"
 _ESBUILD_FLAGS = ("--bundle", "--format=esm", "--minify", "--charset=utf8", "--log-level=warning",
                   "--external:../../vendor/*", "--sourcemap=external", "--sourcefile=page.js")
+FORMAT = 2  # how a bundle and its source map are made here: a change makes every bundle again
 _UNBUNDLABLE_CSS = re.compile(r"""@import|@charset|url\(\s*(?!['"]?data:)""", re.IGNORECASE)
 
 
@@ -70,10 +71,10 @@ class Bundles:
     """Makes and remembers each page's bundles. store(name, data) writes a file into the static store
     (hashed name, compressed forms) and makes the server serve it."""
 
-    def __init__(self, static_dir: Path, build_dir: Path, hashed: dict[str, str], closure: Callable,
+    def __init__(self, static_dir: Path, build_dir: Path, hashed: dict[str, str],
                  store: Callable[[str, bytes], None], esbuild: str | None):
         self.static_dir, self.build_dir, self.hashed = static_dir, build_dir, hashed
-        self._closure, self._store, self.esbuild = closure, store, esbuild
+        self._store, self.esbuild = store, esbuild
         self._made: dict[tuple[str, ...], str | None] = {}
         self._lock = threading.Lock()
 
@@ -109,11 +110,12 @@ class Bundles:
             return self._made[key]
 
     def _key(self, kind: str, names: list[str] | tuple[str, ...]) -> str:
-        # What the bundle is made of: the tool, the entries, and every file they reach, by content.
-        parts = [kind, ESBUILD_VERSION, *_ESBUILD_FLAGS, "|", *names, "|"]
+        # What the bundle is made of: the tool, the entries, and by content every module that could be
+        # in it (all of static/js: a change anywhere there makes each page's bundle again at its next
+        # first request, which gives the same URL when its content is the same).
+        parts = [kind, str(FORMAT), ESBUILD_VERSION, *_ESBUILD_FLAGS, "|", *names, "|"]
         if kind == "js":
-            eager, later = self._closure(list(names))
-            parts += [self.hashed.get(name, name) for name in eager + later]
+            parts += sorted(hashed for plain, hashed in self.hashed.items() if plain.startswith("js/"))
         else:
             parts += [self.hashed.get(name, name) for name in names]
         return hashlib.sha256("\n".join(parts).encode()).hexdigest()
@@ -153,7 +155,7 @@ class Bundles:
             if run.returncode != 0:
                 raise ValueError(f"esbuild: {run.stderr.decode(errors='replace').strip()[:500]}")
             code = out.read_bytes()
-            source_map = (Path(tmp) / "page.js.map").read_bytes()
+            source_map = self._sources_from_bundle(json.loads((Path(tmp) / "page.js.map").read_text()), Path(tmp))
             kept = [i["path"] for o in json.loads(meta.read_text())["outputs"].values() for i in o.get("imports", ())]
         # Whatever the bundle still imports must be a file of static/ as seen from its place.
         for spec in kept:
@@ -162,12 +164,20 @@ class Bundles:
                 raise ValueError(f"the bundle of {entries[0]}... imports {spec!r}, not a file of static/")
         if b"import.meta" in code:  # a module's own URL would be the bundle's: its relative URLs would miss
             raise ValueError(f"a module of {', '.join(entries)} uses import.meta")
-        name = f"{JS_BUNDLES}/{_digest(code)}.js"
+        name = f"{JS_BUNDLES}/{_digest(code + source_map)}.js"  # the pair: each is stored once under its name
         self._store(name + ".map", source_map)
         self._store(name, code + f"//# sourceMappingURL={name.rsplit('/', 1)[1]}.map\n".encode())
         self._remember(key, name)
         log.info("page bundle %s: %d modules, %d bytes", name, len(entries), len(code))
         return name
+
+    def _sources_from_bundle(self, source_map: dict, made_in: Path) -> bytes:
+        # esbuild names the sources from where it wrote the bundle; name them from where it is served
+        # ('../core/api.js' from js/bundle/), which also keeps the server's own paths out of the map.
+        served_from = self.static_dir / JS_BUNDLES
+        source_map["sources"] = [os.path.relpath(os.path.normpath(made_in / source), served_from).replace(os.sep, "/")
+                                 for source in source_map["sources"]]
+        return json.dumps(source_map, separators=(",", ":")).encode()
 
     def _make_styles(self, sheets: list[str]) -> str:
         key = self._key("css", sheets)

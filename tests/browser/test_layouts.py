@@ -5,6 +5,7 @@ the phone, keeps the e-stop and the link pills outside the layout, opens one eve
 the channels its cards need, and no video without a camera card.
 """
 
+import os
 import re
 
 import pytest
@@ -116,7 +117,7 @@ def page_modules(live_server, requested):
     code = requests.get(live_server.url + bundle[0], timeout=5).text
     source_map = requests.get(live_server.url + "/static/js/bundle/" + re.search(r"sourceMappingURL=(\S+)", code)[1],
                               timeout=5).json()
-    return {re.sub(r"^.*?static/", "", source) for source in source_map["sources"]}
+    return {os.path.normpath(os.path.join("js/bundle", source)) for source in source_map["sources"]}
 
 
 def test_the_page_opens_one_stream_for_its_cards_channels_and_no_video_without_a_camera(live_server, browser):
