@@ -47,7 +47,8 @@ esbuild_bin=(.tools/esbuild/node_modules/@esbuild/*/bin/esbuild)
 if [[ "$("${esbuild_bin[0]}" --version 2>/dev/null)" != "$esbuild_version" ]]; then
   if command -v npm >/dev/null; then
     echo "== installing esbuild $esbuild_version (npm) into .tools/esbuild"
-    npm install --prefix .tools/esbuild --no-save --no-audit --no-fund --loglevel=error "esbuild@$esbuild_version"
+    npm install --prefix .tools/esbuild --no-save --no-audit --no-fund --loglevel=error "esbuild@$esbuild_version" \
+      || echo "!! esbuild not installed (is the npm registry reachable?): pages are served without bundles" >&2
   else
     echo "!! npm not found: pages are served without bundles (docs/page_load.md)" >&2
   fi
