@@ -3,6 +3,7 @@
     .venv/bin/python bench/page_load.py --profile radio|wifi-edge|starlink|wifi-good|loopback
                                         [--pages dashboard,waypoints,livemap,robots,plot,recordings]
                                         [--tree /work/main] [--timeout 60] [--seed 1] [--no-preload]
+                                        [--list-requests] [--timeline]
 
 Starts the demo's simulator (`python -m rover_web.sim`) and the app (`flask run`, from --tree: this
 checkout by default; another checkout, such as main, to measure before a change: started with no
@@ -21,6 +22,7 @@ Per load, from the navigation's start (the page's own clock, performance.now()):
 - live_ms: the first event shown: <body data-link="up"> (static/js/link/honest.js), set when the
   event stream delivers.
 - whole_ms: every static file, tile and basemap the page fetched has arrived and the load event ran.
+- dcl_ms: DOMContentLoaded: every module script of the page ran; live.js opens the event stream then.
 - floor_ms: the physical floor of this load: bytes ÷ the link's rate + 3 round trips (connect, the
   document, its subresources named up front). No load can beat it on this link.
 The last line is one JSON object (as bench/link.py): the profile, and per page and cold/warm the
@@ -37,6 +39,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections import Counter
 from functools import partial
 from pathlib import Path
 
@@ -55,7 +58,9 @@ PAGES = {
     "plot": "/plot?topic=/odom&field=twist.twist.linear.x",
     "recordings": "/recordings",
 }
-KEYS = ("bytes", "wire_bytes", "requests", "ttfb_ms", "estop_ms", "live_ms", "whole_ms", "floor_ms")
+FILES = re.compile(r"^https?://[^/]+/(static|tiles|basemap)/")  # what "whole" waits for, as COLLECT
+QUIET_S = 1.0  # nothing more asked for this long after the first event: the page is whole
+KEYS = ("bytes", "wire_bytes", "requests", "ttfb_ms", "estop_ms", "live_ms", "whole_ms", "floor_ms", "dcl_ms")
 
 # Runs before any of the page's scripts, in every document of the context.
 OBSERVE = """
@@ -81,8 +86,10 @@ COLLECT = """
   const nav = performance.getEntriesByType('navigation')[0];
   const fetched = performance.getEntriesByType('resource')
     .filter((r) => /\\/(static|tiles|basemap)\\//.test(r.name)).map((r) => r.responseEnd);
+  const timeline = performance.getEntriesByType('resource')
+    .map((r) => [Math.round(r.startTime), Math.round(r.responseEnd), r.name.replace(/^https?:\\/\\/[^/]+/, '')]);
   return { ttfb: nav.responseStart, load: nav.loadEventEnd, last: Math.max(0, ...fetched),
-           estop: window.__pl.estop, live: window.__pl.live };
+           dcl: nav.domContentLoadedEventStart, estop: window.__pl.estop, live: window.__pl.live, timeline };
 }
 """
 
@@ -97,9 +104,15 @@ class NetLog:
         cdp.on("Network.requestServedFromCache", lambda e: self.cached.add(e["requestId"]))
         cdp.on("Network.loadingFinished", lambda e: self.finished.__setitem__(e["requestId"], e["encodedDataLength"]))
         cdp.on("Network.responseReceived", self._response)
+        cdp.on("Network.loadingFailed", lambda e: self.finished.__setitem__(e["requestId"], 0))
 
     def reset(self):
         self.sent, self.cached, self.finished, self.streams = {}, set(), {}, set()
+
+    def pending_files(self) -> list[str]:
+        """Static files, tiles and basemaps asked for and not yet arrived (nor failed, nor cached)."""
+        return [url for rid, url in self.sent.items() if FILES.search(url)
+                and rid not in self.finished and rid not in self.cached]
 
     def _sent(self, e):
         if e["request"]["url"].startswith("http"):
@@ -160,10 +173,18 @@ def measure(page, net: NetLog, emu: LinkEmulator, link, go, timeout_s: float) ->
     go()
     page.wait_for_function("() => window.__pl && window.__pl.live !== null && document.readyState === 'complete'",
                            timeout=timeout_s * 1000)
-    try:
-        page.wait_for_load_state("networkidle", timeout=timeout_s * 1000)
-    except Exception:  # noqa: BLE001 - a page that polls may never be idle; what it fetched is measured all the same
-        pass
+    # Then every file the page asks for, the libraries it starts on its first event included, has
+    # arrived and nothing more came for a moment. Not Playwright's "networkidle": that also counts a
+    # quiet moment before the first event (a bundled page reaches one), after which MapLibre was missed.
+    deadline, quiet_since = time.monotonic() + timeout_s, None
+    while time.monotonic() < deadline:
+        if net.pending_files():
+            quiet_since = None
+        elif quiet_since is None:
+            quiet_since = time.monotonic()
+        elif time.monotonic() - quiet_since >= QUIET_S:
+            break
+        page.wait_for_timeout(50)  # the browser's events keep coming meanwhile
     got = page.evaluate(COLLECT)
     wire = emu.counters()["down"]["bytes_passed"] - down_before
     body, count, urls = net.figures()
@@ -171,7 +192,8 @@ def measure(page, net: NetLog, emu: LinkEmulator, link, go, timeout_s: float) ->
     return {"bytes": body, "wire_bytes": wire, "requests": count, "ttfb_ms": round(got["ttfb"]),
             "estop_ms": None if got["estop"] is None else round(got["estop"]),
             "live_ms": round(got["live"]), "whole_ms": round(max(got["load"], got["last"])),
-            "floor_ms": round(floor), "static_requests": sum("/static/" in u for u in urls)}
+            "floor_ms": round(floor), "static_requests": sum("/static/" in u for u in urls), "urls": urls,
+            "dcl_ms": round(got["dcl"]), "timeline": got["timeline"]}
 
 
 def run(args) -> dict:
@@ -230,6 +252,14 @@ def run(args) -> dict:
                               f"the wire with streams) in {r['requests']:3d} requests ({r['static_requests']} static); "
                               f"TTFB {r['ttfb_ms']} ms, e-stop {r['estop_ms']} ms, live {r['live_ms']} ms, "
                               f"whole {r['whole_ms']} ms; floor {r['floor_ms']} ms", flush=True)
+                        urls, timeline = r.pop("urls"), r.pop("timeline")
+                        if args.timeline:
+                            print(f"    DOMContentLoaded {r['dcl_ms']} ms; started → ended ms, each request:")
+                            for started, ended, what in sorted(timeline):
+                                print(f"    {started:6d} → {ended:6d}  {what[:110]}")
+                        if args.list_requests:
+                            paths = Counter(re.sub(r"^https?://[^/]+|\?.*$", "", u) for u in urls)
+                            print("    " + ", ".join(f"{p} ×{n}" if n > 1 else p for p, n in paths.most_common()))
                 if "error" in results[name]:
                     print(f"{name:10s} failed: {results[name]['error']}", flush=True)
             browser.close()
@@ -264,6 +294,10 @@ def main() -> None:
     parser.add_argument("--no-preload", action="store_true",
                         help="strip the pages' modulepreload links (what naming the modules up front saves); "
                              "cold figures only: intercepting requests turns Chromium's cache off")
+    parser.add_argument("--timeline", action="store_true",
+                        help="print each load's requests with when they started and ended (Resource Timing)")
+    parser.add_argument("--list-requests", action="store_true",
+                        help="print each load's requests by path (what went to the network, and how often)")
     print(json.dumps(run(parser.parse_args())), flush=True)
 
 

@@ -37,6 +37,9 @@ SETTINGS: tuple[Setting, ...] = (
     Setting("STATIC_BUILD_DIR", None, "optional_str",
             "where hashed, brotli and gzip copies of static/ are kept (made at start, content-addressed); "
             "unset: build/static beside static/ (docs/page_load.md)"),
+    Setting("BUNDLE", True, "bool",
+            "serve each page's modules as one bundle and its stylesheets as one file (esbuild, made at a page's "
+            "first request, kept in the store); off: each file on its own, named up front (docs/page_load.md)"),
     Setting("DB_PATH", None, "optional_str",
             "SQLite database file; unset means rover_web.sqlite3 in the Flask instance folder"),
     # --- HTTP protection ---

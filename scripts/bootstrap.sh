@@ -39,6 +39,21 @@ if [[ ! -f "$stamp" || "$(cat "$stamp")" != "$digest" ]]; then
   echo "$digest" > "$stamp"
 fi
 
+# esbuild bundles each page's modules when the page is first asked for (docs/page_load.md): a native
+# binary from the npm registry, pinned (rover_web/web/bundles.py names the version), kept in .tools/.
+# Without npm the GUI still runs, each module served on its own (slower on a slow link).
+esbuild_version=$(sed -n 's/^ESBUILD_VERSION = "\([0-9.]*\)".*/\1/p' rover_web/web/bundles.py)
+esbuild_bin=(.tools/esbuild/node_modules/@esbuild/*/bin/esbuild)
+if [[ "$("${esbuild_bin[0]}" --version 2>/dev/null)" != "$esbuild_version" ]]; then
+  if command -v npm >/dev/null; then
+    echo "== installing esbuild $esbuild_version (npm) into .tools/esbuild"
+    npm install --prefix .tools/esbuild --no-save --no-audit --no-fund --loglevel=error "esbuild@$esbuild_version" \
+      || echo "!! esbuild not installed (is the npm registry reachable?): pages are served without bundles" >&2
+  else
+    echo "!! npm not found: pages are served without bundles (docs/page_load.md)" >&2
+  fi
+fi
+
 # tf2_msgs and nav2_msgs have no wheel: built once from interfaces/ with ROS 2's own generators
 # (skipped when a sourced ROS 2 install has them, and while interfaces/ is unchanged).
 scripts/build_interfaces.sh .venv

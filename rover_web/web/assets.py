@@ -37,6 +37,7 @@ from flask_compress import Compress
 from whitenoise import WhiteNoise
 from whitenoise.compress import Compressor
 
+from .bundles import Bundles, find_esbuild
 from .http import CONTENT_SECURITY_POLICY
 
 log = logging.getLogger(__name__)
@@ -48,6 +49,7 @@ _IMPORT = re.compile(r"""^[ \t]*(?:import|export)\b[^'";]*?\bfrom\s*(['"])(\.{1,
                      r"""|^[ \t]*import\s*(['"])(\.{1,2}/[^'"]+)\3""", re.MULTILINE)
 _DYNAMIC = re.compile(r"""\bimport\(\s*(['"])(\.{1,2}/[^'"]+)\1\s*\)""")
 _MODULE_SCRIPT = re.compile(r"""<script type="module" src="([^"]+)"></script>""")
+_STYLESHEET = re.compile(r"""<link rel="stylesheet" href="([^"]+\.css)">""")
 # Compress what compresses; images, fonts and archives are compressed already.
 _COMPRESSIBLE = re.compile(r"\.(js|mjs|css|json|geojson|svg|html|txt|map|xml)\Z")
 
@@ -122,20 +124,26 @@ def build(static_dir: Path, build_dir: Path, generated: dict[str, bytes] | None 
             text = data.decode("utf-8", "replace")
             manifest.imports[name] = tuple(_resolve(name, m.group(2) or m.group(4)) for m in _IMPORT.finditer(text))
             manifest.dynamic[name] = tuple(_resolve(name, m.group(2)) for m in _DYNAMIC.finditer(text))
-        target = build_dir / hashed
-        if target.exists():
-            continue
-        target.parent.mkdir(parents=True, exist_ok=True)
-        if _COMPRESSIBLE.search(name):
-            for suffix, compress in ((".br", compressor.compress_brotli), (".gz", compressor.compress_gzip)):
-                packed = compress(data)
-                if len(packed) < len(data) * 0.95:  # as WhiteNoise's own rule: not worth a header otherwise
-                    _write_atomically(target.with_name(target.name + suffix), packed)
-        _write_atomically(target, data)
-        made += 1
+        made += store(build_dir, hashed, data, compressor)
     if made:
         log.info("static files: %d new hashed copies in %s", made, build_dir)
     return manifest
+
+
+def store(build_dir: Path, hashed: str, data: bytes, compressor: Compressor | None = None) -> bool:
+    """Put a file under its hashed name into the store with its brotli and gzip forms; False: it was there."""
+    target = build_dir / hashed
+    if target.exists():
+        return False
+    compressor = compressor or Compressor(quiet=True)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    if _COMPRESSIBLE.search(hashed):
+        for suffix, compress in ((".br", compressor.compress_brotli), (".gz", compressor.compress_gzip)):
+            packed = compress(data)
+            if len(packed) < len(data) * 0.95:  # as WhiteNoise's own rule: not worth a header otherwise
+                _write_atomically(target.with_name(target.name + suffix), packed)
+    _write_atomically(target, data)
+    return True
 
 
 def _static_headers(headers, path, url) -> None:
@@ -144,26 +152,46 @@ def _static_headers(headers, path, url) -> None:
     headers["X-Content-Type-Options"] = "nosniff"
 
 
-def _page_head(manifest: Manifest, body: str, static_root: str) -> tuple[str, str] | None:
-    """The import map and modulepreload links for a page's module scripts, and the map's nonce."""
+def _page(manifest: Manifest, bundles: Bundles | None, body: str, static_root: str) -> tuple[str, str | None]:
+    """The page with its stylesheets joined and its modules bundled (or named up front), and the nonce
+    of its import map (None: the page has no module script)."""
     prefix = static_root + "/"
-    entries = []
-    for src in _MODULE_SCRIPT.findall(body):
-        src = html.unescape(src)
-        if src.startswith(prefix):
-            plain = manifest.plain_of.get(src[len(prefix):])
-            if plain:
-                entries.append(plain)
+
+    def plain(url: str) -> str | None:
+        url = html.unescape(url)
+        return manifest.plain_of.get(url[len(prefix):]) if url.startswith(prefix) else None
+
+    if bundles is not None:
+        sheets = [(m.group(0), plain(m.group(1))) for m in _STYLESHEET.finditer(body)]
+        joined_name, joined = bundles.styles(list(dict.fromkeys(name for _, name in sheets if name)))
+        if joined_name:
+            link = f'<link rel="stylesheet" href="{html.escape(prefix + joined_name)}">'
+            for tag, name in sheets:  # the first joined sheet's place takes them all, in their order
+                if name in joined:
+                    body, link = body.replace(tag, link, 1), ""
+    scripts = [(m.group(0), plain(m.group(1))) for m in _MODULE_SCRIPT.finditer(body)]
+    entries = list(dict.fromkeys(name for _, name in scripts if name))
     if not entries:
-        return None
+        return body, None
     eager, later = manifest.closure(entries)
     mapped = {prefix + name: prefix + manifest.hashed[name] for name in eager + later if name in manifest.hashed}
     nonce = secrets.token_urlsafe(16)
     imports = json.dumps({"imports": mapped}, separators=(",", ":")).replace("</", "<\\/")
     lines = [f'<script type="importmap" nonce="{nonce}">{imports}</script>']
+    bundle = bundles.scripts(entries) if bundles is not None else None
+    if bundle:
+        for tag, name in scripts:
+            if name is not None and name.startswith("js/"):
+                body = body.replace(tag, "", 1)
+        # In the head: its download starts as the page's first bytes arrive; a module runs after parsing.
+        lines.append(f'<script type="module" src="{html.escape(prefix + bundle)}"></script>')
+        preload = [name for name in eager if not name.startswith("js/")]  # what the bundle keeps outside
+    else:
+        preload = [name for name in eager if name not in entries]
     lines += [f'<link rel="modulepreload" href="{html.escape(prefix + manifest.hashed[name])}">'
-              for name in eager if name in manifest.hashed and name not in entries]
-    return "\n".join(lines) + "\n", nonce
+              for name in preload if name in manifest.hashed]
+    at = body.find("</head>")
+    return body[:at] + "\n".join(lines) + "\n" + body[at:], nonce
 
 
 def build_dir_for(static_dir: Path, setting: str | None) -> Path:
@@ -192,6 +220,18 @@ def init_app(app: Flask) -> None:
         wn.add_file_to_dictionary(f"{static_url}/{hashed}", str(build_dir / hashed), stat_cache=None)
     app.wsgi_app = wn
 
+    def serve(name: str, data: bytes) -> None:  # a page's bundle, made at its first request
+        store(build_dir, name, data)
+        wn.add_file_to_dictionary(f"{static_url}/{name}", str(build_dir / name), stat_cache=None)
+
+    bundles = None
+    if app.config.get("ROVER_WEB_BUNDLE", True):
+        esbuild = find_esbuild(Path(__file__).resolve().parents[2])
+        if esbuild is None:
+            log.warning("esbuild not found (scripts/bootstrap.sh installs it into .tools/): each page's modules "
+                        "are served one by one, named up front; slower on a slow link (docs/page_load.md)")
+        bundles = Bundles(static_dir, build_dir, manifest.hashed, serve, esbuild)
+
     @app.url_defaults
     def _hashed_static(endpoint, values):
         if endpoint == "static" and "filename" in values:
@@ -215,14 +255,12 @@ def init_app(app: Flask) -> None:
                 or response.status_code >= 300 and response.status_code != 404):
             return response
         body = response.get_data(as_text=True)
-        at = body.find("</head>")
-        if at < 0:
+        if body.find("</head>") < 0:
             return response
-        made = _page_head(manifest, body, request.script_root + static_url)
-        if made is None:
+        body, nonce = _page(manifest, bundles, body, request.script_root + static_url)
+        response.set_data(body)
+        if nonce is None:
             return response
-        head, nonce = made
-        response.set_data(body[:at] + head + body[at:])
         response.headers["Content-Security-Policy"] = CONTENT_SECURITY_POLICY.replace(
             "script-src 'self'", f"script-src 'self' 'nonce-{nonce}'")
         return response

@@ -5,6 +5,9 @@ the phone, keeps the e-stop and the link pills outside the layout, opens one eve
 the channels its cards need, and no video without a camera card.
 """
 
+import os
+import re
+
 import pytest
 import requests
 
@@ -107,6 +110,16 @@ def test_a_default_layout_on_a_phone_stacks_in_layout_order_without_sideways_scr
         context.close()
 
 
+def page_modules(live_server, requested):
+    """The modules of the page's bundle (rover_web/web/bundles.py), by the bundle's source map."""
+    bundle = [u for u in requested if re.fullmatch(r"/static/js/bundle/[0-9a-f]{12}\.js", u.split("?")[0])]
+    assert len(bundle) == 1, requested
+    code = requests.get(live_server.url + bundle[0], timeout=5).text
+    source_map = requests.get(live_server.url + "/static/js/bundle/" + re.search(r"sourceMappingURL=(\S+)", code)[1],
+                              timeout=5).json()
+    return {os.path.normpath(os.path.join("js/bundle", source)) for source in source_map["sources"]}
+
+
 def test_the_page_opens_one_stream_for_its_cards_channels_and_no_video_without_a_camera(live_server, browser):
     doc = {"version": 1, "name": "Drive only", "cards": [
         {"type": "drive", "x": 0, "y": 0, "w": 6, "h": 6}, {"type": "robot", "x": 6, "y": 0, "w": 6, "h": 3}]}
@@ -121,7 +134,9 @@ def test_the_page_opens_one_stream_for_its_cards_channels_and_no_video_without_a
         channels = set(streams[0].split("channels=")[1].split("&")[0].split(","))
         assert channels == {"status", "teleop", "odom", "battery"} | ALWAYS
         assert not [u for u in page.requested if u.startswith(VIDEO_PATHS)]
-        assert not [u for u in page.requested if "/js/camera/camera." in u or "maplibre" in u or "uPlot" in u]
+        assert not [u for u in page.requested if "maplibre" in u or "uPlot" in u]
+        assert "js/camera/camera.js" not in page_modules(live_server, page.requested)
+        assert "js/teleop/teleop.js" in page_modules(live_server, page.requested)
         check_clean(page)
     finally:
         context.close()
@@ -129,7 +144,10 @@ def test_the_page_opens_one_stream_for_its_cards_channels_and_no_video_without_a
     choose(live_server, "Boat")  # a camera card: its script runs and asks for the topic it shows
     context, page = open_dashboard(browser, live_server, DESKTOP)
     try:
-        assert any("/js/camera/camera." in u for u in page.requested)
+        assert "js/camera/camera.js" in page_modules(live_server, page.requested)
+        # It ran: it shows the topic it looks for (no camera in this graph: it says it waits for it).
+        page.wait_for_function("() => /image/.test(document.getElementById('camera-message').textContent)",
+                               timeout=10000)
         streams = [u for u in page.requested if u.startswith("/api/events")]
         channels = set(streams[0].split("channels=")[1].split("&")[0].split(","))
         assert "light_sequence" in channels and "diagnostics" not in channels and "pose" not in channels

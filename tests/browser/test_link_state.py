@@ -16,6 +16,14 @@ pytestmark = [pytest.mark.browser, pytest.mark.ros]
 
 ODOM = "nav_msgs/msg/Odometry"
 
+
+@pytest.fixture
+def live_server(live_server_factory):
+    # These tests reach the page's own live.js by importing its URL, which gives the page's instance
+    # only while the page loads its modules one by one: a bundle's modules are its own
+    # (rover_web/web/bundles.py), so the page is served unbundled here.
+    return live_server_factory(ROVER_WEB_BUNDLE=False)
+
 # Every odom and status event the page's handlers get, with its id (live.js is a module: importing
 # it again returns the page's own instance).
 RECORD = """async () => {

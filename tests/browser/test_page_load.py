@@ -46,8 +46,15 @@ def test_the_form_estop_keeps_the_origin_rule(live_server):
 
 
 def test_with_scripts_on_the_notice_goes_and_the_estop_does_not_post_the_form(live_server, page):
+    asked = []
+    page.on("request", lambda r: asked.append(r.url[len(live_server.url):]))
     page.goto(live_server.url + "/")
     page.wait_for_selector("body[data-link='up']", timeout=15000)
+    # The page ran from its bundle (rover_web/web/bundles.py): one module file, one stylesheet of its own.
+    modules = [u for u in asked if u.startswith("/static/js/")]
+    assert len(modules) == 1 and re.fullmatch(r"/static/js/bundle/[0-9a-f]{12}\.js", modules[0]), modules
+    assert [u for u in asked if u.startswith("/static/css/")] == [
+        u for u in asked if re.fullmatch(r"/static/css/bundle/[0-9a-f]{12}\.css", u)], asked
     assert page.locator("#scripts-pending").count() == 0
     page.locator("#estop-engage").click()
     page.wait_for_selector("#estop[data-engaged='yes']", timeout=5000)

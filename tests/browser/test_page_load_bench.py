@@ -13,7 +13,7 @@ pytestmark = pytest.mark.browser
 
 ROOT = Path(__file__).resolve().parents[2]
 FIGURES = {"bytes", "wire_bytes", "requests", "ttfb_ms", "estop_ms", "live_ms", "whole_ms", "floor_ms",
-           "static_requests"}
+           "static_requests", "dcl_ms"}
 
 
 def run_bench(*args: str, timeout: float) -> dict:

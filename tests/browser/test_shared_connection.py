@@ -25,6 +25,14 @@ pytestmark = pytest.mark.browser
 
 TABS = 8
 
+
+@pytest.fixture
+def live_server(live_server_factory):
+    # These tests reach the page's own live.js by importing its URL, which gives the page's instance
+    # only while the page loads its modules one by one: a bundle's modules are its own
+    # (rover_web/web/bundles.py), so the page is served unbundled here.
+    return live_server_factory(ROVER_WEB_BUNDLE=False)
+
 SET_HIDDEN = """(hidden) => {
     Object.defineProperty(document, 'hidden', { value: hidden, configurable: true });
     Object.defineProperty(document, 'visibilityState', { value: hidden ? 'hidden' : 'visible', configurable: true });

@@ -193,7 +193,10 @@ def _offer() -> str:
     return _real_offer()
 
 
-def test_the_drive_card_can_use_the_teleop_channel(live_server, sim_process, webrtc_page):
+def test_the_drive_card_can_use_the_teleop_channel(live_server_factory, sim_process, webrtc_page):
+    # The page's own teleop_channel.js is reached by importing its URL: the page's modules one by one
+    # (a bundle's modules are its own, rover_web/web/bundles.py).
+    live_server = live_server_factory(ROVER_WEB_BUNDLE=False)
     sim_process()
     page = webrtc_page
     page.goto(live_server.url + "/")

@@ -54,9 +54,8 @@ def test_pages_and_api_answers_are_compressed_but_never_cached_as_immutable(clie
     assert "Accept-Encoding" in page.headers["Vary"]
     assert "immutable" not in page.headers.get("Cache-Control", "")
     html = brotli.decompress(page.get_data()).decode()
-    # Static URLs in the page are the hashed ones, and its modules are named up front.
-    assert 'src="/static/js/live/live.' in html and 'src="/static/js/live/live.js"' not in html
-    assert '<link rel="modulepreload" href="/static/js/core/api.' in html
+    # Static URLs in the page are the hashed ones: its bundle, and in the import map each module.
+    assert re.search(r'<script type="module" src="/static/js/bundle/[0-9a-f]{12}\.js"></script>', html)
     imports = re.search(r'<script type="importmap" nonce="[^"]+">(.*?)</script>', html).group(1)
     assert '"/static/js/core/api.js":"/static/js/core/api.' in imports
     assert html.index('type="importmap"') < html.index('type="module"')
@@ -70,9 +69,12 @@ def test_pages_and_api_answers_are_compressed_but_never_cached_as_immutable(clie
     assert "Content-Encoding" not in plain.headers and b"</html>" in plain.get_data()
 
 
-def test_every_module_a_page_imports_statically_is_preloaded(app, client):
+def test_unbundled_every_module_a_page_imports_statically_is_preloaded(app_factory):
+    # ROVER_WEB_BUNDLE off (or no esbuild): the page's own module scripts, and the rest named up front.
+    app = app_factory(ROVER_WEB_BUNDLE=False)
     manifest = app.extensions["rover_web.assets"]
-    html = client.get("/").get_data(as_text=True)
+    html = app.test_client().get("/").get_data(as_text=True)
+    assert 'src="/static/js/live/live.' in html and 'src="/static/js/live/live.js"' not in html
     entries = [manifest.plain_of[src[len("/static/"):]]
                for src in re.findall(r'<script type="module" src="([^"]+)"', html)]
     preloaded = {manifest.plain_of[href[len("/static/"):]]
