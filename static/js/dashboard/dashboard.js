@@ -3,6 +3,11 @@ import { _, formatNumber, formatUnit } from '../core/i18n.js';
 
 const text = (id, value) => { const el = document.getElementById(id); if (el) el.textContent = value; };
 
+// BatteryState's power_supply_status as rover_web/telemetry/msgs.py names it.
+const SUPPLY = {
+  charging: _('charging'), discharging: _('discharging'), 'not charging': _('not charging'), full: _('full'), unknown: _('unknown'),
+};
+
 on('status', (s) => {
   text('status-uptime', formatUnit(s.uptime_s, 's', 0));
   const body = document.getElementById('status-topics');
@@ -33,6 +38,6 @@ if (document.getElementById('odom-card')) {
     text('odom-battery-percent', b.percent === null ? '—' : formatNumber(b.percent, 0));
     text('odom-battery-voltage', b.voltage === null ? '—' : formatNumber(b.voltage, 2));
     const el = document.getElementById('odom-battery');
-    if (el) el.title = `${el.dataset.topic}: ${b.status}`;
+    if (el) el.title = `${el.dataset.topic}: ${SUPPLY[b.status] || b.status}`;
   });
 }

@@ -223,7 +223,7 @@ export function attachGeofence(map) {
     redraw();
   });
   $('gf-save').addEventListener('click', () => save({ type: 'FeatureCollection', features: draft.map(strip) }, _('Saved')));
-  $('gf-revert').addEventListener('click', () => { show(fence); say('Changes dropped'); });
+  $('gf-revert').addEventListener('click', () => { show(fence); say(_('Changes dropped')); });
   $('gf-import').addEventListener('change', async (ev) => {
     const file = ev.target.files[0];
     ev.target.value = '';

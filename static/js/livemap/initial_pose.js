@@ -8,8 +8,8 @@ import { degrees, metres, say } from './readout.js';
 import { _ } from '../core/i18n.js';
 
 export const POSE_MODE = 'pose';
-export const POSE_HINT = _('Press where the robot really is and drag the way it faces (a click keeps its heading). '
-  + 'Esc cancels.');
+export const POSE_HINT = _(
+  'Press where the robot really is and drag the way it faces (a click keeps its heading). Esc cancels.');
 
 const mapPath = (name) => `/api/maps/${encodeURIComponent(name)}`;
 

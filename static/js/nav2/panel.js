@@ -83,7 +83,8 @@ export function attachNav2(S, { redraw, say }) {
     const list = $('nav2-route');
     list.replaceChildren(...S.route.map((p, i) => {
       const li = document.createElement('li');
-      li.textContent = _('%(name)s (%(x)s, %(y)s)', { name: p.name || _('point %(n)d', { n: i + 1 }), x: fmt(p.x, 2), y: fmt(p.y, 2) });
+      const name = p.name || _('point %(n)d', { n: i + 1 });  // a call of its own: Babel misses one nested in another
+      li.textContent = _('%(name)s (%(x)s, %(y)s)', { name, x: fmt(p.x, 2), y: fmt(p.y, 2) });
       return li;
     }));
     $('nav2-route-empty').hidden = S.route.length > 0;
@@ -164,7 +165,8 @@ export function attachNav2(S, { redraw, say }) {
       if (reply) {
         const p = reply.goal.poses[0];
         S.goal = { x: p.x, y: p.y, yaw: p.yaw, frame_id: reply.goal.frame_id };
-        say(_('Goal sent to Nav2: %(what)s (%(position)s).', { what, position: _('%(x)s, %(y)s m', { x: fmt(x, 2), y: fmt(y, 2) }) }));
+        const position = _('%(x)s, %(y)s m', { x: fmt(x, 2), y: fmt(y, 2) });
+        say(_('Goal sent to Nav2: %(what)s (%(position)s).', { what, position }));
       }
       redraw();
     },

@@ -121,7 +121,7 @@ function init(container) {
   }
 
   async function refresh() {
-    try { render(await api('GET', '/api/waypoints')); } catch (err) { say(`Could not reload the list: ${err.message}`, 'error'); }
+    try { render(await api('GET', '/api/waypoints')); } catch (err) { say(_('Could not reload the list: %(reason)s', { reason: err.message }), 'error'); }
   }
 
   async function edit(method, id, body) {
@@ -156,7 +156,7 @@ function init(container) {
   $('wp-clear').addEventListener('click', async () => {
     const n = state.mission.waypoints.length;
     if (!n || !window.confirm(ngettext('Delete the %(num)d waypoint?', 'Delete all %(num)d waypoints?', n))) return;
-    try { await api('DELETE', '/api/waypoints'); say('All waypoints deleted'); } catch (err) { say(err.message, 'error'); }
+    try { await api('DELETE', '/api/waypoints'); say(_('All waypoints deleted')); } catch (err) { say(err.message, 'error'); }
     await refresh();
   });
   $('wp-import').addEventListener('change', async (ev) => {
