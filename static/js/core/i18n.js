@@ -83,12 +83,20 @@ export function _(msgid, values) {
 
 export const gettext = _;
 
-// gettext's plural forms from Intl's categories: English and Spanish have two (n == 1, the rest:
-// Spanish's "many" for a million is gettext's second form), Japanese one.
+// gettext's plural forms from Intl's categories. Babel writes a language's forms in CLDR's order of
+// categories (zero, one, two, few, many, other: Spanish's three are one, many for a round million, and
+// other; English's two are one and other; Japanese has other alone), and Intl knows the same
+// categories, so a category's place among the language's is its form's index. Should the browser's
+// CLDR and Babel's ever disagree on the count, "one" is the first form and anything else the last.
+const CATEGORY_ORDER = ['zero', 'one', 'two', 'few', 'many', 'other'];
 const rules = new Intl.PluralRules(locale);
+const categories = [...rules.resolvedOptions().pluralCategories]
+  .sort((a, b) => CATEGORY_ORDER.indexOf(a) - CATEGORY_ORDER.indexOf(b));
 function formIndex(n, count) {
   if (count <= 1) return 0;
-  return rules.select(n) === 'one' ? 0 : Math.min(1, count - 1);
+  const category = rules.select(n);
+  if (categories.length === count) return categories.indexOf(category);
+  return category === 'one' ? 0 : count - 1;
 }
 
 // ngettext('%(num)d robot', '%(num)d robots', n, values): `num` is n unless values say otherwise,
