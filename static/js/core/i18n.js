@@ -61,9 +61,10 @@ function numberFormat(options) {
 
 // `%(name)s` takes the value as text, `%(name)d` a whole number in the locale's digits and grouping
 // (as Flask-Babel's format_number would), `%%` is a percent sign. A name not given stays as written,
-// so a missing value shows, rather than a blank.
+// so a missing value shows, rather than a blank. As Flask-Babel's gettext, no values: no interpolation
+// (a message with no placeholder writes a plain %).
 export function interpolate(text, values) {
-  if (!values) return text;
+  if (!values || !Object.keys(values).length) return text;
   return text.replace(/%(?:\(([A-Za-z_][A-Za-z0-9_]*)\)([sd])|%)/g, (whole, name, kind) => {
     if (!name) return '%';
     if (!Object.prototype.hasOwnProperty.call(values, name)) return whole;
