@@ -3,7 +3,7 @@
 // links. The list is read from GET /api/recordings every second while the page is open: one small
 // JSON a second, and no event channel to keep for a page few people have open.
 import { api, at, errorFrom } from '../core/api.js';
-import { _, ngettext, formatNumber, formatUnit } from '../core/i18n.js';
+import { _, ngettext, formatNumber, formatUnit, formatDateTime } from '../core/i18n.js';
 
 const $ = (id) => document.getElementById(id);
 const form = $('rec-form');
@@ -54,7 +54,7 @@ function row(rec) {
   tr.dataset.id = rec.id;
   tr.dataset.state = rec.state;
   tr.dataset.source = rec.source;
-  tr.append(cell(rec.name || rec.id), cell(new Date(rec.started_at * 1000).toLocaleString()),
+  tr.append(cell(rec.name || rec.id), cell(formatDateTime(rec.started_at * 1000)),
     cell(duration(rec.duration_s), 'num'), cell(mb(rec.size), 'num'), cell(formatNumber(Object.keys(rec.topics).length), 'num'),
     cell(formatNumber(rec.messages), 'num'), cell(stateText(rec)));
   const actions = document.createElement('td');
