@@ -1,15 +1,16 @@
 """static/js/core/i18n.js in Chromium (issue 43): the browser code's translations and locale formatting.
 
 A real HTTP server (the standard library's, on 127.0.0.1) serves the repository's own static/js files
-and a catalogue JSON made from the shipped translations/<lang>/LC_MESSAGES/browser.po, in the shape the
-app serves it on <html data-catalogue>. Each page here imports the real module: an English page must not
-fetch anything nor wait, a Spanish or Japanese page shows the catalogue's words, and a catalogue that
-cannot be loaded leaves the page working, in English.
+and each language's catalogue JSON as the app makes it from the shipped translations/<lang>/LC_MESSAGES/
+*.po (rover_web/i18n) and names it on <html data-catalogue>; the pages here set that attribute
+themselves, so each case (a missing or a slow catalogue, a bad language tag) is one page. Each imports
+the real module: an English page must not fetch anything nor wait, a Spanish or Japanese page shows the
+catalogue's words, and a catalogue that cannot be loaded leaves the page working, in English.
+(tests/browser/test_i18n_pages.py checks the app's own pages.)
 """
 
 from __future__ import annotations
 
-import json
 import threading
 import time
 from functools import partial
@@ -17,28 +18,18 @@ from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 
 import pytest
-from babel.messages.pofile import read_po
 
 from rover_web.config import ROOT
+from rover_web.i18n.catalogues import compile_language
 
 pytestmark = pytest.mark.browser
 
 SLOW_S = 0.8
 
 
-def catalogue_json(language: str) -> dict:
-    """The browser's catalogue of one language: the shape rover_web/i18n serves (and i18n.js reads)."""
-    with (ROOT / "translations" / language / "LC_MESSAGES" / "browser.po").open("rb") as f:
-        po = read_po(f, locale=language)
-    messages, plurals = {}, {}
-    for m in po:
-        if not m.id or m.fuzzy:
-            continue
-        if isinstance(m.id, tuple):
-            plurals[m.id[0]] = list(m.string)
-        else:
-            messages[m.id] = m.string
-    return {"locale": language, "messages": messages, "plurals": plurals}
+def catalogue_json(language: str) -> bytes:
+    """The browser's catalogue of one language, exactly as the app serves it (rover_web/i18n)."""
+    return compile_language(ROOT / "translations" / language, language).browser
 
 
 # One page per case: the module under test is imported by the page's own module script, which puts what
@@ -92,7 +83,7 @@ class Handler(SimpleHTTPRequestHandler):
 def server():
     pages = {"/probe.js": PROBE.encode()}
     for lang in ("es", "ja"):
-        pages[f"/catalogue.{lang}.json"] = json.dumps(catalogue_json(lang), ensure_ascii=False).encode()
+        pages[f"/catalogue.{lang}.json"] = catalogue_json(lang)
     for name, lang, catalogue in (("en", "en", ""), ("es", "es", "/catalogue.es.json"),
                                   ("ja", "ja", "/catalogue.ja.json"), ("missing", "es", "/catalogue.xx.json"),
                                   ("slow", "es", "/catalogue.es.json?slow=1"), ("bad_lang", "not a tag!", "")):
