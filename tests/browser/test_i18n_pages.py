@@ -68,3 +68,18 @@ def test_the_camera_figures_are_spanish_numbers(live_server, sim_process, page):
     page.wait_for_function(f"{stats}.test(document.getElementById('camera-stats').textContent)", timeout=30000)
     assert "640×480" in page.locator("#camera-stats").inner_text()
     assert not re.search(r"\d\.\d fps", page.locator("#camera-stats").inner_text())
+
+
+def test_an_english_page_names_no_catalogue_and_preloads_i18n_js(live_server, page):
+    requests_made = []
+    page.on("request", lambda r: requests_made.append(r.url))
+    page.goto(live_server.url + "/")
+    page.wait_for_selector("#link-server[data-state='live']", timeout=15000)
+    assert page.evaluate("document.documentElement.lang") == "en"
+    assert page.evaluate("document.documentElement.hasAttribute('data-catalogue')") is False
+    assert not [url for url in requests_made if url.endswith(".json")]
+    # Named up front (rover_web/web/assets.py): every module imports it, so the browser fetches it at once.
+    preloads = page.eval_on_selector_all("link[rel=modulepreload]", "links => links.map((l) => l.href)")
+    assert any("/static/js/core/i18n." in href for href in preloads), preloads
+    assert page.locator("#link-server b").inner_text() == "live"
+    assert page.watch.console_errors == []
