@@ -73,7 +73,7 @@ if (card) {
     s.boxes.forEach((c, i) => {
       if (!boxes[i]) return;
       paint(boxes[i], c);
-      boxes[i].querySelector('.stc-box-name').textContent = c;
+      boxes[i].querySelector('.stc-box-name').textContent = c === null ? '' : colourWord(c);
     });
     const note = $('stc-cycle');
     note.dataset.problem = s.cycle.problems.length ? 'yes' : 'no';
