@@ -25,6 +25,7 @@ from rover_web.i18n.catalogues import compile_language
 pytestmark = pytest.mark.browser
 
 SLOW_S = 0.8
+HANG_S = 30  # far past i18n.js's CATALOGUE_WAIT_MS (8 s)
 
 
 def catalogue_json(language: str) -> bytes:
@@ -65,6 +66,8 @@ class Handler(SimpleHTTPRequestHandler):
         path, _, query = self.path.partition("?")
         if "slow" in query:
             time.sleep(SLOW_S)
+        if "hang" in query:
+            time.sleep(HANG_S)
         if path in self.pages:
             body = self.pages[path]
             kind = "text/html" if path.endswith(".html") else (
@@ -73,7 +76,10 @@ class Handler(SimpleHTTPRequestHandler):
             self.send_header("Content-Type", f"{kind}; charset=utf-8")
             self.send_header("Content-Length", str(len(body)))
             self.end_headers()
-            self.wfile.write(body)
+            try:
+                self.wfile.write(body)
+            except (BrokenPipeError, ConnectionResetError):
+                pass  # the page gave up waiting (the hang case)
             return
         self.path = path
         super().do_GET()
@@ -86,7 +92,8 @@ def server():
         pages[f"/catalogue.{lang}.json"] = catalogue_json(lang)
     for name, lang, catalogue in (("en", "en", ""), ("es", "es", "/catalogue.es.json"),
                                   ("ja", "ja", "/catalogue.ja.json"), ("missing", "es", "/catalogue.xx.json"),
-                                  ("slow", "es", "/catalogue.es.json?slow=1"), ("bad_lang", "not a tag!", "")):
+                                  ("slow", "es", "/catalogue.es.json?slow=1"),
+                                  ("hang", "es", "/catalogue.es.json?hang=1"), ("bad_lang", "not a tag!", "")):
         attr = f' data-catalogue="{catalogue}"' if catalogue else ""
         pages[f"/{name}.html"] = PAGE.format(lang=lang, catalogue=attr).encode()
     Handler.pages = pages
@@ -103,7 +110,7 @@ def open_page(page, server, name):
     page.on("request", lambda r: requests.append(r.url))
     page.goto(f"{server}/{name}.html")
     page.wait_for_function("window.i18n !== undefined && window.events.includes('after page scripts')",
-                           timeout=10000)
+                           timeout=20000)
     return requests
 
 
@@ -187,3 +194,15 @@ def test_modules_waiting_for_a_slow_catalogue_still_run_after_the_page_scripts(p
 def test_a_bad_language_tag_falls_back_to_english(page, server):
     open_page(page, server, "bad_lang")
     assert page.evaluate("[window.i18n.locale, window.i18n.formatNumber(1234.5, 1)]") == ["en", "1,234.5"]
+
+
+def test_a_catalogue_that_never_comes_does_not_hold_the_page(page, server):
+    """A stalled fetch (a radio link that went quiet) ends after i18n.js's wait: the modules run, in English."""
+    errors = []
+    page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+    started = time.monotonic()
+    open_page(page, server, "hang")
+    waited = time.monotonic() - started
+    assert 7.5 < waited < 20, waited
+    assert page.locator("#word").inner_text() == "ENGAGED"
+    assert any("could not be loaded" in e for e in errors), errors

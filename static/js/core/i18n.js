@@ -30,6 +30,7 @@ export function afterPageScripts(fn) {
   else document.addEventListener('DOMContentLoaded', fn, { once: true });
 }
 
+const CATALOGUE_WAIT_MS = 8000;  // a 25 kB file (7 kB compressed): seconds even on a poor radio link
 let messages = {};
 let plurals = {};
 
@@ -37,14 +38,20 @@ const url = root && root.dataset ? root.dataset.catalogue : '';
 if (url) {
   // Top-level await: every module that imports this one waits for the catalogue, so no string is
   // ever drawn in English first. Only a translated page pays this one (cached, immutable) fetch.
+  // A stalled fetch must not hold the page's modules for ever: past CATALOGUE_WAIT_MS the page goes on
+  // in English (the e-stop is a plain form until its module runs, so it works all along).
+  const abort = new AbortController();
+  const timer = setTimeout(() => abort.abort(new Error(`no answer in ${CATALOGUE_WAIT_MS} ms`)), CATALOGUE_WAIT_MS);
   try {
-    const response = await fetch(url, { credentials: 'same-origin' });
+    const response = await fetch(url, { credentials: 'same-origin', signal: abort.signal });
     if (!response.ok) throw new Error(`HTTP ${response.status}`);
     const catalogue = await response.json();
     messages = (catalogue && typeof catalogue.messages === 'object' && catalogue.messages) || {};
     plurals = (catalogue && typeof catalogue.plurals === 'object' && catalogue.plurals) || {};
   } catch (err) {
     console.error(`i18n: the ${locale} catalogue ${url} could not be loaded; the page stays in English`, err);
+  } finally {
+    clearTimeout(timer);
   }
 }
 
