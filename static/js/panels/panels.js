@@ -44,7 +44,7 @@ function refreshButton(root, button) {
 
 function showView(root, view) {
   root.dataset.locked = view.locked ? 'yes' : 'no';
-  root.querySelector('.cp-lock-state').textContent = view.locked ? 'Locked' : 'Unlocked';
+  root.querySelector('.cp-lock-state').textContent = view.locked ? _('Locked') : _('Unlocked');
   root.querySelector('[data-action="unlock"]').hidden = !view.locked;
   root.querySelector('[data-action="lock"]').hidden = view.locked;
   showLight(root, view.light);
@@ -61,7 +61,7 @@ function showView(root, view) {
 function showSummary(root, view) {
   showLight(root, view.light);
   showDisplays(root, view.displays);
-  root.querySelector('.cp-lock-state').textContent = view.locked ? 'locked' : 'unlocked';
+  root.querySelector('.cp-lock-state').textContent = view.locked ? _('locked') : _('unlocked');
 }
 
 on('panel', (data) => {
