@@ -88,3 +88,15 @@ def test_an_english_page_names_no_catalogue_and_preloads_i18n_js(live_server, pa
     assert any("/static/js/core/i18n." in href for href in preloads), preloads
     assert page.locator("#link-server b").inner_text() == "live"
     assert page.watch.console_errors == []
+
+
+@pytest.mark.parametrize("language", ["es", "ja"])
+def test_the_recordings_page_says_its_state_in_the_page_s_language(live_server, page, language):
+    in_language(page, live_server, language)
+    page.goto(live_server.url + "/recordings")
+    status = page.locator("#rec-status")
+    status.wait_for(timeout=10000)
+    page.wait_for_function("document.getElementById('rec-status').textContent !== ''", timeout=10000)
+    assert status.inner_text() == translation(language, "Not recording.")
+    assert page.locator("#rec-rows").inner_text().strip() == translation(language, "No recordings yet.")
+    assert page.watch.console_errors == []
