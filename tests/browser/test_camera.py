@@ -99,7 +99,7 @@ def test_topic_page_lists_the_simulators_topics_and_echoes_one(live_server, sim_
     assert page.watch.offhost == [] and page.watch.console_errors == []
 
 
-STATS = r"/^\d+(\.\d)? fps · \d+×\d+ · \d+ kbit\/s/"
+STATS = r"/^\d+(\.\d)? fps · \d+×\d+ · [\d,]+ kbit\/s/"  # grouped in thousands: 1,250 kbit/s
 
 
 def test_camera_card_shows_fps_size_and_kbps_and_a_snapshot_mode_it_remembers(live_server, sim_process, page):

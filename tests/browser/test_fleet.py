@@ -118,7 +118,7 @@ def test_stop_all_engages_every_robot_and_the_bar_keeps_its_height(fleet, page, 
     page.on("request", lambda r: r.method == "POST" and posted.append(r.url))
     page.locator("#estop-all-engage").click()
     page.wait_for_selector("#estop-all[data-state='done']", timeout=10000)
-    assert page.locator("#estop-all-note").inner_text() == "e-stop engaged: boat, drone"
+    assert page.locator("#estop-all-note").inner_text() == "e-stop engaged: boat and drone"
     assert posted == [server.url + "/api/estop/all"]  # the app's, not under the page's robot
     for name in ("boat", "drone"):
         assert requests.get(robot_url(server, name, "/api/estop"), timeout=5).json()["engaged"] is True
@@ -168,7 +168,7 @@ def test_fleet_page_maps_every_robot_and_follows_their_state(fleet, page):
         assert marker.inner_text() == name
         assert marker.is_visible()  # framed: both robots in view
     rows = {name: page.locator(f"#fleet-table tr[data-robot='{name}']") for name in ("boat", "drone")}
-    assert rows["boat"].locator("[data-field='battery']").inner_text() == "87 % · 24.10 V"
+    assert rows["boat"].locator("[data-field='battery']").inner_text() == "87% · 24.10 V"
     assert rows["drone"].locator("[data-field='battery']").inner_text() == "—"
 
     # Kept current by polling: one robot's e-stop shows on its row and marker only.
@@ -176,7 +176,7 @@ def test_fleet_page_maps_every_robot_and_follows_their_state(fleet, page):
     page.wait_for_selector("#fleet-table tr[data-robot='boat'][data-estop='engaged']", timeout=5000)
     page.wait_for_selector(".fleet-marker[data-robot='boat'][data-estop='engaged']", timeout=5000)
     assert rows["drone"].get_attribute("data-estop") == "released"
-    assert rows["boat"].locator("[data-field='mode']").inner_text() == "estop"
+    assert rows["boat"].locator("[data-field='mode']").inner_text() == "e-stop"
 
     # A hidden tab asks for nothing until it is shown again.
     page.evaluate("""() => {

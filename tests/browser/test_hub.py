@@ -108,7 +108,7 @@ def test_the_hub_page_shows_a_robot_heard_and_the_answers_of_stop_all(hub, stric
     row = page.locator("#hub-table tr[data-robot='alpha'][data-heard='live']")
     row.wait_for(timeout=10000)  # from the template, or added by the page's poll without a reload
     assert row.locator("a").get_attribute("href") == ALPHA_URL
-    assert "81 %" in row.inner_text()
+    assert "81%" in row.inner_text()
     page.click("#hub-stop-all")
     page.locator("#hub-last-stop li[data-robot='alpha']", has_text="alpha: engaged").wait_for(timeout=10000)
     assert robot.engaged

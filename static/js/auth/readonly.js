@@ -1,7 +1,9 @@
 // A viewer's page: every control that would command the robot is disabled, with the reason. The
 // server refuses such requests anyway (403); this only keeps the page honest about it. Controls
 // that change nothing on the robot (a map's zoom, a topic's echo) carry data-viewer-ok.
-const REASON = document.body.dataset.readonlyReason || 'View only: commands need the operator role.';
+import { _ } from '../core/i18n.js';
+
+const REASON = document.body.dataset.readonlyReason || _('View only: commands need the operator role.');
 const CONTROLS = 'main button, main input, main select, main textarea';
 
 function disable(root) {

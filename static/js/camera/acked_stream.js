@@ -8,6 +8,7 @@
 // what the page has acknowledged (docs/camera.md#acknowledging-pages).
 
 import { api, at, errorFrom } from '../core/api.js';
+import { _ } from '../core/i18n.js';
 
 const HEAD_END = [13, 10, 13, 10];  // \r\n\r\n
 const RETRY_ACK_MS = 500;  // an ack refused or not answered: send the newest count again after this
@@ -55,7 +56,7 @@ export class PartReader {
         }
         at = end + HEAD_END.length;
         const length = Number.parseInt(headers['content-length'], 10);
-        if (!Number.isFinite(length) || length < 0) throw new Error('a stream part without a Content-Length');
+        if (!Number.isFinite(length) || length < 0) throw new Error(_('a stream part without a Content-Length'));
         this.need = { headers, length };
       }
       if (this.buf.length - at < this.need.length) break;
@@ -133,13 +134,13 @@ export function playAcked(img, url, show, fail) {
     if (!response.ok) throw await errorFrom(response);
     const viewerId = response.headers.get('X-Camera-Viewer');
     acks = viewerId ? acker(viewerId, isStopped) : null;  // none: the server does not adapt, nothing to say
-    if (!response.body) throw new Error('this browser cannot read the stream as it arrives');
+    if (!response.body) throw new Error(_('this browser cannot read the stream as it arrives'));
     const reader = response.body.getReader();
     const parts = new PartReader();
     let received = 0;
     for (;;) {
       const { done, value } = await reader.read();
-      if (done) throw new Error('the stream ended');
+      if (done) throw new Error(_('the stream ended'));
       if (stopped) return;
       received += value.length;
       const complete = parts.push(value);

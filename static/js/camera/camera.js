@@ -13,6 +13,7 @@ import { playAcked, supported as ackedSupported } from './acked_stream.js';
 import { describe, watchViewer } from './stats.js';
 import { pollSnapshots } from './snapshots.js';
 import { play as playWebRtc, stop as stopWebRtc } from './webrtc.js';
+import { _ } from '../core/i18n.js';
 
 const card = document.getElementById('camera-card');
 const STORAGE_KEY = 'rover_web.camera.topic';
@@ -71,7 +72,7 @@ if (card) {
     if (stopWatching) { stopWatching(); stopWatching = null; }
     if (stopAcked) { stopAcked(); stopAcked = null; }
     streaming = null;
-    say(`the stream from ${topic} stopped; retrying`);
+    say(_('the stream from %(topic)s stopped; retrying', { topic }));
     recheckTimer = setTimeout(refreshTopics, RECHECK_MS);
   }
 
@@ -89,10 +90,10 @@ if (card) {
     if (streaming === url) return;
     stop();
     streaming = url;
-    say(`snapshots of ${topic}…`);
-    img.alt = `snapshots from ${topic}`;
+    say(_('snapshots of %(topic)s…', { topic }));
+    img.alt = _('snapshots from %(topic)s', { topic });
     stopWatching = pollSnapshots(img, url, (figures) => { say(''); showStats(figures); },
-      (reason) => say(`snapshot of ${topic}: ${reason}`));
+      (reason) => say(_('snapshot of %(topic)s: %(reason)s', { topic, reason })));
   }
 
   function start() {
@@ -100,7 +101,7 @@ if (card) {
     if (document.hidden) { stop(); return; }
     if (!imageTopics.has(topic)) {
       stop();
-      say(`no image topic ${topic} in the ROS graph yet; waiting for it`);
+      say(_('no image topic %(topic)s in the ROS graph yet; waiting for it', { topic }));
       recheckTimer = setTimeout(refreshTopics, RECHECK_MS);
       return;
     }
@@ -118,8 +119,8 @@ if (card) {
     if (streaming === url) return;
     stop();
     streaming = url;
-    say(`connecting to ${topic}…`);
-    img.alt = `live image from ${topic}`;
+    say(_('connecting to %(topic)s…', { topic }));
+    img.alt = _('live image from %(topic)s', { topic });
     if (ackedSupported()) {
       img.dataset.transport = 'mjpeg-acked';
       // The page's own figures; the server's report adds whether it lowered quality or size.
@@ -131,7 +132,7 @@ if (card) {
       }, (reason) => {
         if (streaming !== url) return;
         streamStopped();
-        say(`the stream from ${topic} stopped (${reason}); retrying`);
+        say(_('the stream from %(topic)s stopped (%(reason)s); retrying', { topic, reason }));
       });
       return;
     }

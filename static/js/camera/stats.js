@@ -3,15 +3,16 @@
 // its link, docs/camera.md). A few hundred bytes every two seconds, and only while streaming.
 
 import { api } from '../core/api.js';
+import { _, formatNumber, formatUnit } from '../core/i18n.js';
 
 const EVERY_MS = 2000;
 
 // "12.5 fps · 640×480 · 850 kbit/s" (and the quality when the server lowered it).
 export function describe(report) {
-  const parts = [`${report.fps.toFixed(report.fps < 10 ? 1 : 0)} fps`];
+  const parts = [_('%(fps)s fps', { fps: formatNumber(report.fps, report.fps < 10 ? 1 : 0) })];
   if (report.width && report.height) parts.push(`${report.width}×${report.height}`);
-  parts.push(`${Math.round(report.kbps)} kbit/s`);
-  if (report.adapt && report.step > 0 && report.quality) parts.push(`quality ${report.quality}`);
+  parts.push(formatUnit(Math.round(report.kbps), 'kbit/s'));
+  if (report.adapt && report.step > 0 && report.quality) parts.push(_('quality %(quality)s', { quality: report.quality }));
   return parts.join(' · ');
 }
 

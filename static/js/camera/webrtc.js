@@ -9,6 +9,7 @@
 
 import { at } from '../core/api.js';
 import { attachTeleopChannel } from './teleop_channel.js';
+import { _, formatNumber, formatUnit } from '../core/i18n.js';
 
 const STORAGE_KEY = 'rover_web.camera.transport';
 const CONNECT_TIMEOUT_MS = 6000;
@@ -68,7 +69,7 @@ function fail(why) {
   stop();
   failedTopic = topic;
   card.dataset.transportInUse = 'mjpeg';
-  showStats(`WebRTC unavailable (${why}); showing MJPEG`);
+  showStats(_('WebRTC unavailable (%(why)s); showing MJPEG', { why }));
   onFallback();
 }
 
@@ -77,7 +78,7 @@ async function start(topic) {
   const mine = { pc, location: null, topic, timer: null, statsTimer: null, last: null };
   session = mine;
   card.dataset.transportInUse = 'connecting';
-  mine.timer = setTimeout(() => { if (session === mine && pc.connectionState !== 'connected') fail('no connection'); },
+  mine.timer = setTimeout(() => { if (session === mine && pc.connectionState !== 'connected') fail(_('no connection')); },
     CONNECT_TIMEOUT_MS);
   pc.addTransceiver('video', { direction: 'recvonly' });
   if (card.dataset.canOperate === 'yes') {
@@ -95,7 +96,7 @@ async function start(topic) {
       video.hidden = false;
       mine.statsTimer = setInterval(() => readStats(mine), STATS_MS);
     } else if (pc.connectionState === 'failed' || pc.connectionState === 'closed') {
-      fail(`connection ${pc.connectionState}`);
+      fail(pc.connectionState === 'failed' ? _('connection failed') : _('connection closed'));
     }
   });
   try {
@@ -117,7 +118,7 @@ async function start(topic) {
     if (session !== mine) { release(mine); return; }
     await pc.setRemoteDescription({ type: 'answer', sdp: answer });
   } catch (err) {
-    if (session === mine) fail(err && err.message ? err.message : 'error');
+    if (session === mine) fail(err && err.message ? err.message : _('error'));
   }
 }
 
@@ -176,8 +177,10 @@ async function readStats(s) {
     framesDecoded: inbound.framesDecoded || 0,
   };
   card.dataset.webrtcFramesDecoded = String(stats.framesDecoded);
-  showStats(`WebRTC ${stats.codec} · ${stats.fps} fps · ${stats.width}×${stats.height} · ${stats.kbps} kbit/s`
-    + ` · rtt ${stats.rttMs === null ? '?' : stats.rttMs} ms · frame age ${stats.ageMs === null ? '?' : stats.ageMs} ms`);
+  const ms = (v) => (v === null ? '?' : formatUnit(v, 'ms'));
+  showStats([`WebRTC ${stats.codec}`, _('%(fps)s fps', { fps: formatNumber(stats.fps) }),
+    `${stats.width}×${stats.height}`, formatUnit(stats.kbps, 'kbit/s'),
+    _('rtt %(rtt)s', { rtt: ms(stats.rttMs) }), _('frame age %(age)s', { age: ms(stats.ageMs) })].join(' · '));
 }
 
 if (choice) {

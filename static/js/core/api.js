@@ -7,6 +7,8 @@
 
 // The page's robot: /robots/<name> when it was served under a robot's prefix (several robots),
 // '' otherwise. Every path a page asks for is under it, so a page drives the robot it shows.
+import { _ } from './i18n.js';
+
 export const base = (typeof document !== 'undefined' && document.body && document.body.dataset.base) || '';
 
 // Where the app itself is mounted, before any robot's prefix: routes for every robot at once
@@ -57,7 +59,7 @@ export async function api(method, url, body, options = {}) {
   if (!response.ok) throw await errorFrom(response);
   const reply = await readJSON(response);
   if (reply === undefined) {
-    throw new ApiError(response.status, null, `HTTP ${response.status}: the answer is not JSON`);
+    throw new ApiError(response.status, null, _('HTTP %(status)s: the answer is not JSON', { status: response.status }));
   }
   return reply;
 }

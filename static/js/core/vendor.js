@@ -3,6 +3,8 @@
 // its event stream is live (the status bar), so their bytes do not queue behind the library's.
 // The URLs (content-hashed) are the server's, on <body data-*> (templates/base.html).
 
+import { _ } from './i18n.js';
+
 const LIVE_WAIT_MS = 4000;  // no stream (a page without one, the server away): load anyway after this
 
 const scripts = new Map();
@@ -24,7 +26,7 @@ export function loadScript(url) {
       const el = document.createElement('script');
       el.src = url;
       el.onload = () => resolve();
-      el.onerror = () => reject(new Error(`${url} did not load`));
+      el.onerror = () => reject(new Error(_('%(url)s did not load', { url })));
       document.head.append(el);
     }));
   }

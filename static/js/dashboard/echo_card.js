@@ -3,6 +3,7 @@
 // opens one). Like the camera's video it is closed while the tab is hidden, so the server can end
 // the subscription; a layout without an echo card opens none.
 import { at } from '../core/api.js';
+import { _, formatUnit } from '../core/i18n.js';
 
 const cards = [...document.querySelectorAll('[data-echo-card]')].map((el) => ({ el, source: null }));
 const part = (card, cls) => card.el.querySelector(`.${cls}`);
@@ -16,9 +17,9 @@ function showError(card, text) {
 async function explain(card, url) {
   try {
     const res = await fetch(url, { headers: { Accept: 'application/json' } });
-    if (!res.ok) showError(card, (await res.json()).message || `the server answered ${res.status}`);
+    if (!res.ok) showError(card, (await res.json()).message || _('the server answered %(status)s', { status: res.status }));
     else res.body?.cancel();
-  } catch { showError(card, 'the server was not reached'); }
+  } catch { showError(card, _('the server was not reached')); }
 }
 
 function open(card) {
@@ -28,7 +29,7 @@ function open(card) {
   card.source = source;
   const stats = (d) => {
     if (d.type) part(card, 'echo-card-type').textContent = d.type;
-    if (d.stats) part(card, 'echo-card-rate').textContent = `${d.stats.rate_hz.toFixed(1)} Hz`;
+    if (d.stats) part(card, 'echo-card-rate').textContent = formatUnit(d.stats.rate_hz, 'Hz', 1);
   };
   source.addEventListener('stats', (ev) => { showError(card, ''); stats(JSON.parse(ev.data)); });
   source.addEventListener('echo', (ev) => {

@@ -2,6 +2,7 @@
 // for this user, or for every browser while sign-in is off) reloads the page, which the server
 // renders from the new layout with only its cards' channels.
 import { api, ApiError } from '../core/api.js';
+import { _ } from '../core/i18n.js';
 
 const select = document.getElementById('layout-select');
 const message = document.getElementById('layout-message');
@@ -16,7 +17,7 @@ select?.addEventListener('change', async () => {
     await api('PUT', '/api/me/layout', { id });
     location.reload();
   } catch (err) {
-    say(err instanceof ApiError ? err.message : 'the server was not reached');
+    say(err instanceof ApiError ? err.message : _('the server was not reached'));
     select.disabled = false;
   }
 });

@@ -5,6 +5,7 @@
 import { api, ApiError } from '../core/api.js';
 import { on } from '../live/live.js';
 import { loadUplot } from '../core/vendor.js';
+import { _ } from '../core/i18n.js';
 
 const COLOURS = ['#58a6ff', '#e3b341', '#7ee787', '#ff7b72'];
 const KEEP_ALIVE_MS = 10000;
@@ -23,7 +24,7 @@ const query = (s, seconds) => new URLSearchParams({ topic: s.topic, field: s.fie
 
 function showError(card, err) {
   const el = card.el.querySelector('.plot-card-error');
-  el.textContent = err ? (err instanceof ApiError ? err.message : 'the server was not reached') : '';
+  el.textContent = err ? (err instanceof ApiError ? err.message : _('the server was not reached')) : '';
   el.hidden = !err;
 }
 

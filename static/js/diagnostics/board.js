@@ -2,6 +2,8 @@
 // at a time in the replay view): the worst level per hardware id, and every status with its values.
 // A stale status shows STALE. Pure DOM: no event stream, no request.
 
+import { formatUnit } from '../core/i18n.js';
+
 function row(cells, level) {
   const tr = document.createElement('tr');
   tr.dataset.level = level;
@@ -34,7 +36,7 @@ export function showBoard(d, { hardware = null, body = null, empty = null }) {
     if (empty) empty.hidden = d.statuses.length > 0;
     body.replaceChildren(...d.statuses.map((s) => {
       const level = s.stale ? 'STALE' : s.level_name;
-      return row([level, s.name, s.hardware_id, s.message, `${s.age_s.toFixed(1)} s`, values(s.values)], level);
+      return row([level, s.name, s.hardware_id, s.message, formatUnit(s.age_s, 's', 1), values(s.values)], level);
     }));
   }
 }

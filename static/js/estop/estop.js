@@ -7,6 +7,7 @@ import { api } from '../core/api.js';
 import { on } from '../live/live.js';
 import { operatorName } from '../core/operator.js';
 import { sendEstopOverSocket } from '../teleop/teleop_link.js';
+import { _, formatTime } from '../core/i18n.js';
 
 const SOCKET_CONFIRM_MS = 300;
 const box = document.getElementById('estop');
@@ -22,10 +23,9 @@ let retryTimer = null;
 let confirmed = false;
 
 function sinceText(state) {
-  const who = state.by ? `By ${state.by}` : '';
-  if (!state.since) return who ? `${who}.` : '';
-  const at = new Date(state.since * 1000).toLocaleTimeString();
-  return `${who ? `${who} at` : 'At'} ${at}.`;
+  if (!state.since) return state.by ? _('By %(name)s.', { name: state.by }) : '';
+  const at = formatTime(state.since * 1000);
+  return state.by ? _('By %(name)s at %(time)s.', { name: state.by, time: at }) : _('At %(time)s.', { time: at });
 }
 
 function show(state, unconfirmed = false) {
@@ -33,7 +33,7 @@ function show(state, unconfirmed = false) {
   box.dataset.engaged = engaged ? 'yes' : 'no';
   box.dataset.unconfirmed = unconfirmed ? 'yes' : 'no';
   engageButton.setAttribute('aria-pressed', String(engaged));
-  stateWord.textContent = unconfirmed ? ' (sending…)' : engaged ? ' ENGAGED' : '';
+  stateWord.textContent = unconfirmed ? ` ${_('(sending…)')}` : engaged ? ` ${_('ENGAGED')}` : '';
   banner.hidden = !engaged;
   if (engaged && !unconfirmed) since.textContent = sinceText(state);
   document.body.classList.toggle('estop-engaged', engaged);
@@ -52,7 +52,7 @@ async function postEngage(attempt = 0) {
   } catch (err) {
     console.warn('e-stop not confirmed, retrying', err);
     if (attempt < 40) retryTimer = setTimeout(() => postEngage(attempt + 1), 250);
-    else stateWord.textContent = ' NOT CONFIRMED';
+    else stateWord.textContent = ` ${_('NOT CONFIRMED')}`;
   }
 }
 
@@ -82,9 +82,9 @@ async function release() {
     show(await post(false));
   } catch (err) {
     // Refused (another engage came first, the disk, the role): the latch holds; say why.
-    dialogError.textContent = `Not released: ${err.message}`;
+    dialogError.textContent = _('Not released: %(reason)s', { reason: err.message });
     dialogError.hidden = false;
-    releaseButton.title = `release failed: ${err.message}`;
+    releaseButton.title = _('release failed: %(reason)s', { reason: err.message });
     openDialog(false);
   } finally {
     releaseButton.disabled = false;

@@ -5,6 +5,7 @@
 import { ApiError, api } from '../core/api.js';
 import { operatorName } from '../core/operator.js';
 import { sendEstopOverSocket } from '../teleop/teleop_link.js';
+import { _, formatList } from '../core/i18n.js';
 
 const RETRY_MS = 250;
 const ATTEMPTS = 40;
@@ -17,7 +18,7 @@ let noteTimer = null;
 
 function show(state, text) {
   box.dataset.state = state;
-  button.textContent = { sending: 'STOPPING…', done: 'ALL STOPPED', failed: 'NOT STOPPED' }[state] || 'STOP ALL';
+  button.textContent = { sending: _('STOPPING…'), done: _('ALL STOPPED'), failed: _('NOT STOPPED') }[state] || _('STOP ALL');
   clearTimeout(noteTimer);
   note.textContent = text;
   note.hidden = !text;
@@ -31,8 +32,8 @@ async function post(attempt) {
     const robots = Object.entries(reply.robots);
     const stopped = robots.filter(([, latch]) => latch.engaged).map(([name]) => name);
     const not = robots.filter(([, latch]) => !latch.engaged).map(([name]) => name);
-    if (not.length) show('failed', `not engaged: ${not.join(', ')}`);
-    else show('done', `e-stop engaged: ${stopped.join(', ')}`);
+    if (not.length) show('failed', _('not engaged: %(robots)s', { robots: formatList(not) }));
+    else show('done', _('e-stop engaged: %(robots)s', { robots: formatList(stopped) }));
   } catch (err) {
     // Refused (signed out, ...) is final; no answer or a server error is tried again.
     const final = err instanceof ApiError && err.status < 500;
@@ -40,7 +41,7 @@ async function post(attempt) {
       retryTimer = setTimeout(() => post(attempt + 1), RETRY_MS);
       return;
     }
-    show('failed', `not confirmed: ${err.message}`);
+    show('failed', _('not confirmed: %(reason)s', { reason: err.message }));
   }
 }
 

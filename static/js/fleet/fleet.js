@@ -5,7 +5,8 @@
 // other rover_web tab) would queue behind them. A hidden tab stops asking until it is shown again.
 // Untrusted text (titles, operator names) only ever goes through textContent.
 import { api } from '../core/api.js';
-import { createFleetMap, estopState } from './map.js';
+import { ESTOP_WORDS, LINK_WORDS, MODE_WORDS, createFleetMap, estopState } from './map.js';
+import { _, formatUnit } from '../core/i18n.js';
 
 const POLL_MS = 1000;
 const $ = (id) => document.getElementById(id);
@@ -16,16 +17,20 @@ let timer = null;
 let busy = false;
 
 const fmt = {
-  link: (r) => r.link.replace('_', ' '),
-  mode: (r) => (r.operator ? `${r.mode} (${r.operator})` : r.mode),
-  speed: (r) => (r.speed ? `${r.speed.linear_mps.toFixed(2)} m/s` : '—'),
+  link: (r) => LINK_WORDS[r.link] || r.link.replace('_', ' '),
+  mode: (r) => {
+    const mode = MODE_WORDS[r.mode] || r.mode;
+    return r.operator ? _('%(mode)s (%(operator)s)', { mode, operator: r.operator }) : mode;
+  },
+  speed: (r) => (r.speed ? formatUnit(r.speed.linear_mps, 'm/s', 2) : '—'),
   battery: (r) => {
     const b = r.battery;
     if (!b || (b.percent === null && b.voltage === null)) return '—';
-    const percent = b.percent === null ? '—' : `${b.percent.toFixed(0)} %`;
-    return b.voltage === null ? percent : `${percent} · ${b.voltage.toFixed(2)} V`;
+    const percent = b.percent === null ? '—' : formatUnit(b.percent, '%', 0);
+    return b.voltage === null ? percent : `${percent} · ${formatUnit(b.voltage, 'V', 2)}`;
   },
-  estop: estopState,
+  estop: (r) => ESTOP_WORDS[estopState(r)],
+  // Coordinates keep the dot whatever the language: they are read into other tools as they are.
   position: (r) => (r.position ? `${r.position.lat.toFixed(6)}, ${r.position.lng.toFixed(6)}` : '—'),
 };
 
@@ -56,7 +61,7 @@ function rowFor(robot) {
 
 function renderRow(robot) {
   const row = rowFor(robot);
-  row.dataset.estop = fmt.estop(robot);
+  row.dataset.estop = estopState(robot);
   row.dataset.link = robot.link;
   const link = row.querySelector('[data-field="name"]');
   link.href = robot.url;
@@ -93,7 +98,7 @@ async function poll() {
     note.textContent = NOTE;
   } catch (err) {
     table.dataset.stale = 'yes';
-    note.textContent = `Not updated: ${err.message}`;
+    note.textContent = _('Not updated: %(reason)s', { reason: err.message });
   } finally {
     busy = false;
     if (!document.hidden) timer = setTimeout(poll, POLL_MS);

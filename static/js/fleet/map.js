@@ -9,6 +9,12 @@
 // A robot the hub forgot leaves the map with the list.
 import { createGpsMap, fmtLatLng } from '../gps/gps_map.js';
 import { loadMaplibre } from '../core/vendor.js';
+import { _ } from '../core/i18n.js';
+
+// What a robot's summary words mean to people (rover_web/fleet/summary.py): its link, its mode, its e-stop.
+export const LINK_WORDS = { ok: _('ok'), degraded: _('degraded'), stale: _('stale'), no_data: _('no data') };
+export const MODE_WORDS = { estop: _('e-stop'), driving: _('driving'), operator: _('operator'), idle: _('idle') };
+export const ESTOP_WORDS = { engaged: _('engaged'), released: _('released'), unknown: _('unknown') };
 
 // 'engaged', 'released', or 'unknown' (a robot the hub has heard no summary from yet).
 export function estopState(robot) {
@@ -57,10 +63,13 @@ function showOnMarker(node, robot) {
   node.dataset.lng = String(robot.position.lng);
   node.dataset.lat = String(robot.position.lat);
   node.querySelector('.fleet-marker-name').textContent = robot.title;
-  const lost = robot.heard === 'lost' ? ' · lost: not heard lately' : '';
-  node.title = `${robot.title}: ${robot.mode || '—'}, e-stop ${estop}${lost} · `
-    + `${fmtLatLng(robot.position.lat, robot.position.lng)}${url ? ' · click to open its dashboard' : ''}`;
-  node.setAttribute('aria-label', url ? `${robot.title}: open its dashboard` : robot.title);
+  const parts = [_('%(robot)s: %(mode)s, e-stop %(estop)s',
+    { robot: robot.title, mode: robot.mode ? MODE_WORDS[robot.mode] || robot.mode : '—', estop: ESTOP_WORDS[estop] })];
+  if (robot.heard === 'lost') parts.push(_('lost: not heard lately'));
+  parts.push(fmtLatLng(robot.position.lat, robot.position.lng));
+  if (url) parts.push(_('click to open its dashboard'));
+  node.title = parts.join(' · ');
+  node.setAttribute('aria-label', url ? _('%(robot)s: open its dashboard', { robot: robot.title }) : robot.title);
 }
 
 // The map in `container` (its data-config: the server's map config), drawn once MapLibre has come;
@@ -148,7 +157,7 @@ export function createFleetMap(container, note) {
   const fleetMap = { map: null, render };
   const noMap = (err) => {
     note.hidden = false;
-    note.textContent = `The map cannot be shown in this browser (${err.message}); the table still works.`;
+    note.textContent = _('The map cannot be shown in this browser (%(reason)s); the table still works.', { reason: err.message });
   };
   loadMaplibre().then(() => {
     try {

@@ -7,9 +7,10 @@
 // a role lowered after the page loaded still meets the server's 403, in the server's words.
 import { api } from '../core/api.js';
 import { on } from '../live/live.js';
+import { _, ngettext, formatList } from '../core/i18n.js';
 
 const EMPTY = { type: 'FeatureCollection', features: [] };
-const KIND_TITLES = { keep_in: 'keep-in', keep_out: 'keep-out' };
+const KIND_TITLES = { keep_in: _('keep-in'), keep_out: _('keep-out') };
 
 function $(id) { return document.getElementById(id); }
 
@@ -90,8 +91,10 @@ export function attachGeofence(map) {
     $('gf-finish').disabled = !drawing || drawing.points.length < 3;
     $('gf-delete').disabled = selected < 0;
     $('gf-count').textContent = draft.length
-      ? draft.map((f) => KIND_TITLES[f.properties.kind] + (f.properties.name ? ` "${f.properties.name}"` : '')).join(', ')
-      : 'no fence: waypoints are allowed anywhere';
+      ? formatList(draft.map((f) => (f.properties.name
+        ? _('%(kind)s "%(name)s"', { kind: KIND_TITLES[f.properties.kind], name: f.properties.name })
+        : KIND_TITLES[f.properties.kind])), { style: 'short', type: 'unit' })
+      : _('no fence: waypoints are allowed anywhere');
     if (!loaded) return;
     map.getSource('fence').setData(collection());
     map.getSource('fence-draft').setData(draftShape());
@@ -109,7 +112,7 @@ export function attachGeofence(map) {
       ring.slice(0, -1).forEach((point, v) => {
         const node = document.createElement('div');
         node.className = 'gf-vertex';
-        node.title = 'drag to move this vertex';
+        node.title = _('drag to move this vertex');
         const marker = new maplibregl.Marker({ element: node, draggable: true }).setLngLat(point).addTo(map);
         marker.on('dragend', () => {
           const { lng, lat } = marker.getLngLat().wrap();
@@ -154,10 +157,11 @@ export function attachGeofence(map) {
     const { lng, lat } = e.lngLat.wrap();
     if (drawing) {
       drawing.points.push([lng, lat]);
-      say(`${drawing.points.length} vertices: click on, then "Finish area"`);
+      say(ngettext('%(num)d vertex: click on, then "Finish area"', '%(num)d vertices: click on, then "Finish area"',
+        drawing.points.length));
     } else {
       selected = areaAt(draft, [lng, lat]);
-      say(selected >= 0 ? 'Area selected: drag its vertices, or delete it' : '');
+      say(selected >= 0 ? _('Area selected: drag its vertices, or delete it') : '');
     }
     redraw();
     return true;  // in edit mode a click never adds a waypoint
@@ -166,7 +170,7 @@ export function attachGeofence(map) {
   function startDrawing(kind) {
     drawing = { kind, points: [] };
     selected = -1;
-    say(`Drawing a ${KIND_TITLES[kind]} area: click its corners on the map`);
+    say(_('Drawing a %(kind)s area: click its corners on the map', { kind: KIND_TITLES[kind] }));
     redraw();
   }
 
@@ -177,7 +181,7 @@ export function attachGeofence(map) {
     selected = draft.length - 1;
     drawing = null;
     setDirty(true);
-    say('Area added: "Save fence" to make the server enforce it');
+    say(_('Area added: "Save fence" to make the server enforce it'));
     redraw();
   }
 
@@ -195,9 +199,11 @@ export function attachGeofence(map) {
     try {
       const reply = await api('PUT', '/api/geofence', body);
       show(reply);
-      say(`${what}: the fence has ${reply.features.length} areas (revision ${reply.revision})`);
+      say(ngettext('%(what)s: the fence has %(num)d area (revision %(revision)s)',
+        '%(what)s: the fence has %(num)d areas (revision %(revision)s)', reply.features.length,
+        { what, revision: reply.revision }));
     } catch (err) {
-      say(`Fence not saved: ${err.message}`, 'error');
+      say(_('Fence not saved: %(reason)s', { reason: err.message }), 'error');
     }
   }
 
@@ -213,18 +219,18 @@ export function attachGeofence(map) {
     draft.splice(selected, 1);
     selected = -1;
     setDirty(true);
-    say('Area deleted: "Save fence" to make it so');
+    say(_('Area deleted: "Save fence" to make it so'));
     redraw();
   });
-  $('gf-save').addEventListener('click', () => save({ type: 'FeatureCollection', features: draft.map(strip) }, 'Saved'));
-  $('gf-revert').addEventListener('click', () => { show(fence); say('Changes dropped'); });
+  $('gf-save').addEventListener('click', () => save({ type: 'FeatureCollection', features: draft.map(strip) }, _('Saved')));
+  $('gf-revert').addEventListener('click', () => { show(fence); say(_('Changes dropped')); });
   $('gf-import').addEventListener('change', async (ev) => {
     const file = ev.target.files[0];
     ev.target.value = '';
-    if (file) await save(await file.text(), `Imported ${file.name}`);
+    if (file) await save(await file.text(), _('Imported %(file)s', { file: file.name }));
   });
   document.addEventListener('keydown', (ev) => {
-    if (ev.key === 'Escape' && drawing) { drawing = null; say('Drawing cancelled'); redraw(); }
+    if (ev.key === 'Escape' && drawing) { drawing = null; say(_('Drawing cancelled')); redraw(); }
   });
 
   // Another operator saved a fence: show theirs, unless this page has unsaved changes.
@@ -234,7 +240,7 @@ export function attachGeofence(map) {
     try { latest = await api('GET', '/api/geofence'); } catch { return; /* the next event retries */ }
     if (!dirty) { show(latest); return; }
     fence = latest;  // keep the draft; "Revert" shows theirs
-    say('The fence was changed elsewhere; "Revert" shows the new one', 'error');
+    say(_('The fence was changed elsewhere; "Revert" shows the new one'), 'error');
   });
 
   setDirty(false);

@@ -3,6 +3,8 @@
 // (rover_web/basemap), a graticule to read positions by, and the same controls everywhere.
 // maplibregl is the vendored global (static/vendor/maplibre-gl-*), loaded with `defer`.
 
+// Coordinates keep the decimal point and N/S/E/W whatever the page's language (ISO 6709's letters):
+// operators read them into other tools as they are.
 export function fmtLatLng(lat, lng) {
   const ns = lat >= 0 ? 'N' : 'S';
   const ew = lng >= 0 ? 'E' : 'W';

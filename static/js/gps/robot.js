@@ -2,11 +2,12 @@
 // as an arrow on the dot, its horizontal accuracy as a circle (one standard deviation, from
 // NavSatFix.position_covariance), and its recent track. Channels: `fix` and `heading`.
 import { fmtLatLng } from './gps_map.js';
+import { _, formatUnit } from '../core/i18n.js';
 
 const EMPTY = { type: 'FeatureCollection', features: [] };
 const EARTH_RADIUS_M = 6371008.8;
 const CIRCLE_STEPS = 64;
-const QUALITY_TEXT = { none: 'no fix', fix: 'GPS fix', sbas: 'SBAS fix', gbas: 'GBAS fix (DGPS/RTK)' };
+const QUALITY_TEXT = { none: _('no fix'), fix: _('GPS fix'), sbas: _('SBAS fix'), gbas: _('GBAS fix (DGPS/RTK)') };
 
 export const ROBOT_SOURCES = { track: { type: 'geojson', data: EMPTY }, accuracy: { type: 'geojson', data: EMPTY } };
 export const ROBOT_LAYERS = [
@@ -60,7 +61,7 @@ export function createRobot(out, quality) {
       if (!marker) {
         const node = document.createElement('div');
         node.className = 'wp-robot';
-        node.title = 'robot (GPS fix)';
+        node.title = _('robot (GPS fix)');
         node.append(Object.assign(document.createElement('span'), { className: 'wp-robot-heading' }));
         marker = new maplibregl.Marker({ element: node, rotationAlignment: 'map' }).setLngLat([fix.lng, fix.lat]).addTo(map);
       }
@@ -84,16 +85,16 @@ export function createRobot(out, quality) {
     if (fix.fix) {
       out.dataset.lng = String(fix.lng);
       out.dataset.lat = String(fix.lat);
-      out.textContent = fmtLatLng(fix.lat, fix.lng) + (fix.accuracy_m !== null ? ` ±${fix.accuracy_m} m` : '');
+      out.textContent = fmtLatLng(fix.lat, fix.lng) + (fix.accuracy_m !== null ? ` ±${formatUnit(fix.accuracy_m, 'm')}` : '');
       // The robot's centre (the antenna's offset taken out through TF), or the antenna as it reported.
       out.dataset.placed = fix.placed_by || 'antenna';
       out.title = fix.placed_by === 'tf'
-        ? `base_link, placed by TF from the antenna ${JSON.stringify(fix.antenna_offset_m)} m off it`
-        : 'the antenna\'s own position (no TF for its frame)';
+        ? _('base_link, placed by TF from the antenna %(offset)s m off it', { offset: JSON.stringify(fix.antenna_offset_m) })
+        : _("the antenna's own position (no TF for its frame)");
     } else {
       delete out.dataset.lng;
       delete out.dataset.lat;
-      out.textContent = `no fix (${fix.reason})`;
+      out.textContent = _('no fix (%(reason)s)', { reason: fix.reason });
     }
     const q = fix.fix ? fix.quality || 'fix' : 'none';
     quality.dataset.quality = q;
@@ -115,10 +116,12 @@ export function createRobot(out, quality) {
       heading = next;
       const el = document.getElementById('wp-heading');
       if (el) {
-        el.textContent = heading.stale ? `— (nothing on ${heading.topic} lately)` : `${Math.round(heading.heading_deg)}°`;
+        el.textContent = heading.stale ? `— ${_('(nothing on %(topic)s lately)', { topic: heading.topic })}`
+          : formatUnit(Math.round(heading.heading_deg), '°');
         el.dataset.stale = heading.stale ? 'yes' : 'no';
         el.dataset.placed = heading.placed_by || 'message';
-        el.title = heading.placed_by === 'tf' ? 'the sensor\'s mount on the robot taken out through TF' : `as ${heading.topic} reports it`;
+        el.title = heading.placed_by === 'tf' ? _("the sensor's mount on the robot taken out through TF")
+          : _('as %(topic)s reports it', { topic: heading.topic });
       }
       drawHeading();
     },

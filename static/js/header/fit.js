@@ -3,6 +3,8 @@
 // tighter (header.css: squeeze-1 ... squeeze-3), and last the robot selector joins the menu. The
 // e-stop and "Stop all" never leave the bar. It fits again whenever the window or anything in the
 // bar changes size (a pill's word, the e-stop's state, a longer robot name).
+import { _ } from '../core/i18n.js';
+
 const bar = document.getElementById('topbar');
 const menu = document.getElementById('topbar-menu');
 
@@ -50,7 +52,7 @@ function setup() {
     menu.hidden = !any;
     if (!any) menu.open = false;
     // "More" while some pages are still in the bar, "Menu" once they all are in it.
-    label.textContent = moved.size && moved.size < links.length ? 'More' : 'Menu';
+    label.textContent = moved.size && moved.size < links.length ? _('More') : _('Menu');
   }
 
   // In-flow items all end inside the bar's content box (the menu's panel and the notes float).

@@ -4,8 +4,9 @@
 // the map is the fleet page's (static/js/fleet/map.js): each robot with a position, dimmed once lost.
 import { api } from '../core/api.js';
 import { createFleetMap } from '../fleet/map.js';
-import { createHistory } from './history.js';
+import { answerText, createHistory } from './history.js';
 import { createTable } from './table.js';
+import { _, formatDateTime, formatUnit } from '../core/i18n.js';
 
 const lastStop = document.getElementById('hub-last-stop');
 const forgotten = document.getElementById('hub-forgotten');
@@ -22,12 +23,12 @@ document.getElementById('hub-table').addEventListener('click', (e) => {
 function showStop(stop) {
   if (!stop) return;
   const p = document.createElement('p');
-  p.textContent = `by ${stop.by}, answered in ${stop.took_s} s`;
+  p.textContent = _('by %(name)s, answered in %(took)s', { name: stop.by, took: formatUnit(stop.took_s, 's') });
   const ul = document.createElement('ul');
   for (const [name, a] of Object.entries(stop.robots)) {
     const li = document.createElement('li');
     li.dataset.robot = name;
-    li.textContent = `${name}: ${a.result}${a.reason ? ` (${a.reason})` : ''}`;
+    li.textContent = `${name}: ${answerText(a)}`;
     ul.append(li);
   }
   lastStop.replaceChildren(p, ul);
@@ -38,7 +39,7 @@ function showForgotten(list) {
   forgotten.replaceChildren(...list.map((f) => {
     const li = document.createElement('li');
     li.dataset.robot = f.name;
-    li.textContent = `${f.name}, ${new Date(f.at * 1000).toLocaleString()}`;
+    li.textContent = `${f.name}, ${formatDateTime(f.at * 1000)}`;
     return li;
   }));
 }
@@ -61,7 +62,7 @@ button.addEventListener('click', async () => {
   try {
     showStop(await api('POST', '/api/estop/all', {}));
   } catch (err) {
-    lastStop.textContent = `Stop-all failed: ${err.message}`;
+    lastStop.textContent = _('Stop-all failed: %(reason)s', { reason: err.message });
   } finally {
     button.disabled = false;
   }

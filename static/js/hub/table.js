@@ -2,7 +2,9 @@
 // to reverse), filtered by what the operator types (name, title, state, mode, link, alerts), so a
 // fleet of a hundred robots stays readable. Rows are rebuilt on every poll; the order and the filter
 // are the page's, kept across polls. Untrusted text goes through textContent only.
-import { estopState } from '../fleet/map.js';
+import { ESTOP_WORDS, LINK_WORDS, MODE_WORDS, estopState } from '../fleet/map.js';
+import { EVENT_WORDS } from './history.js';
+import { _, ngettext, formatUnit } from '../core/i18n.js';
 
 const ORDER = { live: 0, waiting: 1, lost: 2 };
 
@@ -37,14 +39,15 @@ function row(r) {
   } else {
     name.textContent = r.title;
   }
-  const heard = cell(r.heard);
+  const heard = cell(EVENT_WORDS[r.heard] || r.heard);
   if (r.forget_in_s != null) {
     const note = document.createElement('span');
     note.className = 'muted';
-    note.textContent = ` (dropped in ${r.forget_in_s} s)`;
+    note.textContent = ` ${_('(dropped in %(time)s)', { time: formatUnit(r.forget_in_s, 's') })}`;
     heard.append(note);
   }
-  const battery = r.battery && r.battery.percent != null ? `${r.battery.percent.toFixed(0)} %` : '—';
+  const battery = r.battery && r.battery.percent != null ? formatUnit(r.battery.percent, '%', 0) : '—';
+  // Coordinates keep the dot whatever the language: they are read into other tools as they are.
   const position = r.position ? `${r.position.lat.toFixed(6)}, ${r.position.lng.toFixed(6)}` : '—';
   const estop = estopState(r);
   const history = document.createElement('td');
@@ -52,9 +55,10 @@ function row(r) {
   open.type = 'button';
   open.className = 'hub-history-open';
   open.dataset.robot = r.name;
-  open.textContent = 'history';
+  open.textContent = _('history');
   history.append(open);
-  tr.append(name, heard, cell(r.link), cell(r.mode || '—'), cell(battery), cell(estop === 'unknown' ? '—' : estop),
+  tr.append(name, heard, cell(LINK_WORDS[r.link] || r.link), cell(r.mode ? MODE_WORDS[r.mode] || r.mode : '—'), cell(battery),
+            cell(estop === 'unknown' ? '—' : ESTOP_WORDS[estop]),
             cell(position), cell((r.alerts || []).join('; ')), history);
   return tr;
 }
@@ -82,8 +86,9 @@ export function createTable(table, filterInput, counts) {
     body.replaceChildren(...shown.map(row));
     const by = { live: 0, waiting: 0, lost: 0 };
     for (const r of robots) by[r.heard] = (by[r.heard] || 0) + 1;
-    counts.textContent = `${robots.length} robots: ${by.live} live, ${by.waiting} waiting, ${by.lost} lost`
-      + (shown.length < robots.length ? ` · ${shown.length} shown` : '');
+    counts.textContent = ngettext('%(num)d robot: %(live)d live, %(waiting)d waiting, %(lost)d lost',
+      '%(num)d robots: %(live)d live, %(waiting)d waiting, %(lost)d lost', robots.length, by)
+      + (shown.length < robots.length ? ` · ${_('%(shown)d shown', { shown: shown.length })}` : '');
   }
 
   for (const button of table.querySelectorAll('button.hub-sort')) {

@@ -12,6 +12,8 @@
 // "stale" whenever data-link is not `up`. The e-stop and the link bar are not greyed (the e-stop
 // must look as usable as it is): they say the connection is lost instead.
 
+import { _ } from '../core/i18n.js';
+
 const EXEMPT = '#estop, #estop-banner, .link-health';
 const observer = new MutationObserver(() => {});
 const WATCH = { subtree: true, childList: true, characterData: true, attributes: true };
@@ -51,7 +53,7 @@ export function showLink(serverState) {
     note.id = 'estop-link';
     note.className = 'estop-link';
     note.setAttribute('role', 'alert');
-    note.textContent = 'connection lost: the state shown may be old';
+    note.textContent = _('connection lost: the state shown may be old');
     box.append(note);
   }
   note.hidden = link !== 'down';

@@ -5,6 +5,7 @@
 import { at } from '../core/api.js';
 import { on } from '../live/live.js';
 import { loadUplot } from '../core/vendor.js';
+import { _ } from '../core/i18n.js';
 
 const KEEP = 300;
 const el = document.getElementById('link-plot');
@@ -20,8 +21,8 @@ function draw() {
     chart = new window.uPlot({
       width: Math.max(240, el.clientWidth), height: 160,
       scales: { ms: { distr: 3 } },
-      series: [{}, { label: 'round trip ms', scale: 'ms', stroke: '#58a6ff', spanGaps: false },
-        { label: 'robot msg age ms', scale: 'ms', stroke: '#e3b341', spanGaps: false }],
+      series: [{}, { label: _('round trip ms'), scale: 'ms', stroke: '#58a6ff', spanGaps: false },
+        { label: _('robot msg age ms'), scale: 'ms', stroke: '#e3b341', spanGaps: false }],
       axes: [{ stroke: '#8b949e' }, { scale: 'ms', stroke: '#8b949e', size: 50 }],
       legend: { live: false },
     }, [t, rtt, age], el);

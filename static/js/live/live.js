@@ -7,6 +7,7 @@
 
 import { markingLive, showLink } from '../link/honest.js';
 import { openStream } from './shared_stream.js';
+import { _, afterPageScripts } from '../core/i18n.js';
 
 const handlers = new Map();
 const stateHandlers = new Set();
@@ -44,12 +45,13 @@ function setServerState(state) {
   if (state === serverState) return;
   serverState = state;
   showLink(state);
-  setPill('link-server', state, state);
-  if (state !== 'live') setPill('link-robot', 'unknown', 'unknown');
+  setPill('link-server', state, SERVER_LABELS[state] || state);
+  if (state !== 'live') setPill('link-robot', 'unknown', ROBOT_LABELS.unknown);
   for (const fn of stateHandlers) fn(state);
 }
 
-const ROBOT_LABELS = { ok: 'ok', degraded: 'degraded', stale: 'stale', no_data: 'no data' };
+const SERVER_LABELS = { connecting: _('connecting'), live: _('live'), reconnecting: _('reconnecting'), lost: _('lost') };
+const ROBOT_LABELS = { ok: _('ok'), degraded: _('degraded'), stale: _('stale'), no_data: _('no data'), unknown: _('unknown') };
 
 // raw: the event's JSON text, id: its id ('' for none). Handlers get (data, {type, data, lastEventId}).
 function dispatch(channel, raw, id) {
@@ -73,16 +75,16 @@ function trouble() {
 }
 
 const ROLE_TITLES = {
-  leader: 'this tab holds the stream for every rover_web tab of this browser',
-  follower: 'the stream comes from another rover_web tab of this browser',
-  own: 'this tab has a stream of its own (tabs share one only over https or on localhost)',
+  leader: _('this tab holds the stream for every rover_web tab of this browser'),
+  follower: _('the stream comes from another rover_web tab of this browser'),
+  own: _('this tab has a stream of its own (tabs share one only over https or on localhost)'),
 };
 
 function showRole(role) {
   const pill = document.getElementById('link-server');
   if (!pill) return;
   pill.dataset.role = role;
-  pill.title = `browser to server: the live event stream; ${ROLE_TITLES[role]}`;
+  pill.title = _('browser to server: the live event stream; %(role)s', { role: ROLE_TITLES[role] });
 }
 
 function open() {
@@ -124,7 +126,7 @@ const openOnce = () => {
 };
 if (document.readyState === 'complete') queueMicrotask(openOnce);
 else {
-  document.addEventListener('DOMContentLoaded', openOnce);
+  afterPageScripts(openOnce);  // DOMContentLoaded, or now if it passed while a catalogue loaded
   window.addEventListener('load', openOnce);  // in case this module was loaded after DOMContentLoaded
 }
 setInterval(watchdog, 500);

@@ -1,6 +1,7 @@
 // The canvas. drawScene paints one frame from a plain description of it and returns where things
 // landed on screen (published for tests and the curious); it keeps no state between frames.
 import { insideMap, isDrag, screenAngle, screenOfMapYaw, worldToScreen } from './geometry.js';
+import { formatUnit } from '../core/i18n.js';
 
 export const COLORS = { robot: '#1f6feb', robotStale: '#6e7681', heading: '#ffffff', goal: '#f0883e',
   plan: '#3fb950', waypoint: '#d2a8ff', preview: '#f0883e', background: '#0b0f13', keepOut: '#f85149',
@@ -171,5 +172,5 @@ function niceLength(metres) {
 export function scaleBar(g, view) {
   const metresPerScreenPx = g.res / view.scale;
   const metres = niceLength(100 * metresPerScreenPx);
-  return { widthPx: metres / metresPerScreenPx, label: metres >= 1 ? `${metres} m` : `${Math.round(metres * 100)} cm` };
+  return { widthPx: metres / metresPerScreenPx, label: metres >= 1 ? formatUnit(metres, 'm') : formatUnit(Math.round(metres * 100), 'cm') };
 }

@@ -4,11 +4,12 @@
 // has (or east, with no pose), since an operator correcting a position rarely knows a better one.
 import { api, ApiError } from '../core/api.js';
 import { isDrag, mapYawOfScreen, screenAngle, screenToWorld, wrapAngle } from './geometry.js';
-import { degrees, fmt, say } from './readout.js';
+import { degrees, metres, say } from './readout.js';
+import { _ } from '../core/i18n.js';
 
 export const POSE_MODE = 'pose';
-export const POSE_HINT = 'Press where the robot really is and drag the way it faces (a click keeps its heading). '
-  + 'Esc cancels.';
+export const POSE_HINT = _(
+  'Press where the robot really is and drag the way it faces (a click keeps its heading). Esc cancels.');
 
 const mapPath = (name) => `/api/maps/${encodeURIComponent(name)}`;
 
@@ -22,15 +23,17 @@ export function poseYaw(g, sx, sy, ex, ey, pose) {
 export async function sendInitialPose(S, x, y, yaw, redraw) {
   const body = { x, y, yaw };
   S.lastInitialPose = { request: body, status: 'sending' };
-  say('Setting the initial pose…');
+  say(_('Setting the initial pose…'));
   try {
     const reply = await api('POST', `${mapPath(S.map)}/initial_pose`, body);
     S.lastInitialPose = { request: body, status: 200, reply };
-    say(`Initial pose sent on ${reply.topic}: ${fmt(x)}, ${fmt(y)} m, ${degrees(yaw)}.`);
+    say(_('Initial pose sent on %(topic)s: %(position)s, %(heading)s.',
+      { topic: reply.topic, position: metres(x, y), heading: degrees(yaw) }));
   } catch (err) {
     const refused = err instanceof ApiError;
     S.lastInitialPose = { request: body, status: refused ? err.status : 'failed', reply: refused ? err.reply || {} : {} };
-    say(refused ? `Initial pose refused: ${err.message}` : 'Initial pose not sent: the server did not answer.', true);
+    say(refused ? _('Initial pose refused: %(reason)s', { reason: err.message })
+      : _('Initial pose not sent: the server did not answer.'), true);
   }
   redraw();
 }

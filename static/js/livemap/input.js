@@ -2,6 +2,7 @@
 // two pinch, a click on a waypoint sends it; what the gestures change goes through `act`.
 import { gestureYaw, isDrag, screenToPixel, screenToWorld, worldToScreen } from './geometry.js';
 import { POSE_MODE } from './initial_pose.js';
+import { _ } from '../core/i18n.js';
 
 const WAYPOINT_HIT_PX = 12;
 // Modes whose press-and-drag draws an arrow and sends it (a goal, or the initial pose) instead of panning.
@@ -45,7 +46,7 @@ export function attachInput(canvas, S, act) {
     const [x, y] = screenToWorld(S.geometry, S.view, sx, sy);
     const yaw = gestureYaw(S.geometry, sx, sy, ex, ey, x, y, act.livePose());
     if (toRoute && act.addToRoute) act.addToRoute({ x, y, yaw });
-    else act.sendGoal(x, y, yaw, 'map point');
+    else act.sendGoal(x, y, yaw, _('map point'));
   }
 
   canvas.addEventListener('pointerdown', (event) => {

@@ -13,6 +13,7 @@ import { POSE_HINT, POSE_MODE, finishPoseGesture } from './initial_pose.js';
 import { createLayers } from './layers/layers.js';
 import { attachNav2 } from '../nav2/panel.js';
 import { drawNav2 } from '../nav2/draw.js';
+import { _ } from '../core/i18n.js';
 
 export { worldToPixel, pixelToWorld };
 
@@ -58,7 +59,7 @@ if (gp && gp.x !== undefined) S.goal = { x: gp.x, y: gp.y, yaw: gp.yaw, frame_id
 const image = new Image();
 image.decoding = 'async';
 image.onload = () => { S.imageLoaded = true; root.dataset.imageLoaded = 'yes'; requestDraw(); };
-image.onerror = () => say(`Could not load the floorplan image of ${S.label}.`, true);
+image.onerror = () => say(_('Could not load the floorplan image of %(map)s.', { map: S.label }), true);
 image.src = data.map.urls.image;
 
 // --- frames: any number of changes between two animation frames cost one draw ---
@@ -117,7 +118,7 @@ function setMode(mode) {
   $('livemap-pose-mode').setAttribute('aria-pressed', mode === POSE_MODE ? 'true' : 'false');
   root.dataset.mode = mode;
   canvas.style.cursor = mode === 'pan' ? 'grab' : 'crosshair';
-  if (mode === 'goal') say('Click the goal, or press and drag towards the heading you want. Esc cancels.');
+  if (mode === 'goal') say(_('Click the goal, or press and drag towards the heading you want. Esc cancels.'));
   if (mode === POSE_MODE) say(POSE_HINT);
   requestDraw();
 }

@@ -1,5 +1,6 @@
 // Dashboard thumbnail of the default map: a dot where the robot is, a link to the live map.
 import { on } from '../live/live.js';
+import { _, formatNumber } from '../core/i18n.js';
 
 const thumb = document.getElementById('livemap-thumb');
 const dot = document.getElementById('livemap-thumb-robot');
@@ -21,7 +22,7 @@ if (thumb && dot) {
     dot.hidden = !shown;
     dot.dataset.stale = pose.stale ? 'yes' : 'no';
     if (shown) place(pixel.x, pixel.y);
-    label.textContent = pose.stale ? 'no pose'
-      : `${pose.x.toFixed(1)}, ${pose.y.toFixed(1)} m${shown ? '' : ' (off this map)'}`;
+    const at = _('%(x)s, %(y)s m', { x: formatNumber(pose.x, 1), y: formatNumber(pose.y, 1) });
+    label.textContent = pose.stale ? _('no pose') : shown ? at : _('%(position)s (off this map)', { position: at });
   });
 }

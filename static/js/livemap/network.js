@@ -3,7 +3,8 @@
 import { api, ApiError } from '../core/api.js';
 import { on, onServerState } from '../live/live.js';
 import { geometryOfLiveMap } from './geometry.js';
-import { degrees, fmt, say } from './readout.js';
+import { degrees, metres, say } from './readout.js';
+import { _ } from '../core/i18n.js';
 
 const mapPath = (name) => `/api/maps/${encodeURIComponent(name)}`;
 export const mapPageUrl = (name) => `/livemap/${encodeURIComponent(name)}`;
@@ -17,19 +18,19 @@ const goalOf = (g) => ({ x: g.x, y: g.y, yaw: g.yaw, frame_id: g.frame_id });
 export async function sendGoal(S, x, y, yaw, what, redraw) {
   const body = { x, y, yaw };
   S.lastGoal = { request: body, status: 'sending' };
-  say(`Sending ${what}…`);
+  say(_('Sending %(what)s…', { what }));
   try {
     const reply = await api('POST', `${mapPath(S.map)}/goal`, body);
     S.lastGoal = { request: body, status: 200, reply };  // api() resolves only on 2xx; this route answers 200
     S.goal = goalOf(reply.goal);
-    say(`Goal sent: ${what} (${fmt(x)}, ${fmt(y)} m, ${degrees(yaw)}).`);
+    say(_('Goal sent: %(what)s (%(position)s, %(heading)s).', { what, position: metres(x, y), heading: degrees(yaw) }));
   } catch (err) {
     if (err instanceof ApiError) {
       S.lastGoal = { request: body, status: err.status, reply: err.reply || {} };
-      say(`Goal refused: ${err.message}`, true);
+      say(_('Goal refused: %(reason)s', { reason: err.message }), true);
     } else {
       S.lastGoal = { request: body, status: 'failed' };
-      say('Goal not sent: the server did not answer.', true);
+      say(_('Goal not sent: the server did not answer.'), true);
     }
   }
   redraw();

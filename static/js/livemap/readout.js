@@ -1,11 +1,14 @@
 // What is read rather than drawn: the text beside the canvas, its scale bar, the message line, and
 // window.liveMapState, which mirrors what was drawn for the browser tests and curious operators.
 import { scaleBar } from './draw.js';
+import { _, ngettext, formatNumber, formatUnit } from '../core/i18n.js';
 
 const $ = (id) => document.getElementById(id);
 
-export const fmt = (v, digits = 2) => (Number.isFinite(v) ? v.toFixed(digits) : '—');
-export const degrees = (rad) => `${Math.round((rad * 180) / Math.PI)}°`;
+export const fmt = (v, digits = 2) => (Number.isFinite(v) ? formatNumber(v, digits) : '—');
+export const degrees = (rad) => formatUnit(Math.round((rad * 180) / Math.PI), '°');
+// "x, y m" with the language's separator between the two (a comma is Spanish's decimal sign).
+export const metres = (x, y, digits = 2) => _('%(x)s, %(y)s m', { x: fmt(x, digits), y: fmt(y, digits) });
 
 export function say(text, isError = false) {
   const el = $('livemap-message');
@@ -27,17 +30,18 @@ export function publish(root, S, drawn, stale) {
   const poseState = !S.pose ? 'none' : stale ? 'stale' : 'live';
   if (pill.dataset.state !== poseState) {
     pill.dataset.state = poseState;
-    pill.textContent = poseState === 'live' ? 'pose live' : 'no pose';
+    pill.textContent = poseState === 'live' ? _('pose live') : _('no pose');
     root.dataset.poseState = poseState;
   }
   $('livemap-robot').textContent = S.pose
-    ? `${fmt(S.pose.x)}, ${fmt(S.pose.y)} m · ${degrees(S.pose.yaw)}${stale ? ' (stale)' : ''}` : '—';
-  $('livemap-goal').textContent = S.goal ? `${fmt(S.goal.x)}, ${fmt(S.goal.y)} m · ${degrees(S.goal.yaw)}` : '—';
+    ? `${metres(S.pose.x, S.pose.y)} · ${degrees(S.pose.yaw)}${stale ? ` ${_('(stale)')}` : ''}` : '—';
+  $('livemap-goal').textContent = S.goal ? `${metres(S.goal.x, S.goal.y)} · ${degrees(S.goal.yaw)}` : '—';
   $('livemap-path').textContent = S.plan && S.plan.points.length
-    ? `${S.plan.length} poses${S.plan.points.length < S.plan.length ? ` (${S.plan.points.length} drawn)` : ''}` : '—';
-  $('livemap-cursor').textContent = S.cursor ? `${fmt(S.cursor[0])}, ${fmt(S.cursor[1])} m` : '—';
+    ? ngettext('%(num)d pose', '%(num)d poses', S.plan.length) + (S.plan.points.length < S.plan.length
+      ? ` ${_('(%(drawn)d drawn)', { drawn: S.plan.points.length })}` : '') : '—';
+  $('livemap-cursor').textContent = S.cursor ? metres(S.cursor[0], S.cursor[1]) : '—';
   const cmPerScreenPx = (S.geometry.res * 100) / S.view.scale;
-  $('livemap-scale').textContent = `${fmt(cmPerScreenPx, cmPerScreenPx < 1 ? 2 : 1)} cm per pixel`;
+  $('livemap-scale').textContent = _('%(cm)s cm per pixel', { cm: fmt(cmPerScreenPx, cmPerScreenPx < 1 ? 2 : 1) });
   $('livemap-goal-mode').setAttribute('aria-pressed', S.mode === 'goal' ? 'true' : 'false');
   $('livemap-pose-mode').setAttribute('aria-pressed', S.mode === 'pose' ? 'true' : 'false');
   root.dataset.mode = S.mode;

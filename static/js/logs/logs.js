@@ -5,6 +5,7 @@
 // stops the table moving; resume reloads it from the server.
 import { api, ApiError } from '../core/api.js';
 import { on } from '../live/live.js';
+import { _, ngettext, formatNumber, formatTime } from '../core/i18n.js';
 
 const LEVELS = { DEBUG: 10, INFO: 20, WARN: 30, ERROR: 40, FATAL: 50 };
 const SHOWN = 200;
@@ -34,9 +35,11 @@ function matches(line, f) {
 
 const same = (a, b) => a.level === b.level && a.node === b.node && a.msg === b.msg;
 
+// A log line's time to the millisecond, on a 24-hour clock, in the page's locale.
+const CLOCK_MS = { hour: '2-digit', minute: '2-digit', second: '2-digit', fractionalSecondDigits: 3, hourCycle: 'h23' };
+
 function time(stamp) {
-  const d = new Date(stamp * 1000);
-  return `${d.toLocaleTimeString([], { hour12: false })}.${String(d.getMilliseconds()).padStart(3, '0')}`;
+  return formatTime(stamp * 1000, CLOCK_MS);
 }
 
 function render() {
@@ -44,7 +47,7 @@ function render() {
     const tr = document.createElement('tr');
     tr.dataset.level = line.level_name;
     for (const [text, cls] of [[time(line.stamp), ''], [line.level_name, ''], [line.node, ''],
-      [line.msg, 'log-msg'], [line.count > 1 ? String(line.count) : '', 'log-count']]) {
+      [line.msg, 'log-msg'], [line.count > 1 ? formatNumber(line.count) : '', 'log-count']]) {
       const td = document.createElement('td');
       td.textContent = text;
       if (cls) td.className = cls;
@@ -53,8 +56,9 @@ function render() {
     tr.title = line.file ? `${line.file}:${line.line} ${line.function}` : '';
     return tr;
   }));
-  $('logs-count').textContent = `(${rows.length >= SHOWN ? `newest ${SHOWN}` : rows.length})`;
-  $('log-state').textContent = paused ? `paused${held ? `: ${held} new lines not shown` : ''}` : 'live';
+  $('logs-count').textContent = `(${rows.length >= SHOWN ? _('newest %(num)d', { num: SHOWN }) : formatNumber(rows.length)})`;
+  $('log-state').textContent = !paused ? _('live') : held
+    ? ngettext('paused: %(num)d new line not shown', 'paused: %(num)d new lines not shown', held) : _('paused');
 }
 
 async function reload() {
@@ -72,7 +76,7 @@ async function reload() {
     $('log-error').hidden = true;
     render();
   } catch (err) {
-    $('log-error').textContent = err instanceof ApiError ? err.message : 'the server was not reached';
+    $('log-error').textContent = err instanceof ApiError ? err.message : _('the server was not reached');
     $('log-error').hidden = false;
   }
 }
@@ -110,7 +114,7 @@ $('log-filters').addEventListener('submit', (e) => { e.preventDefault(); reload(
 pause.addEventListener('click', () => {
   paused = !paused;
   pause.setAttribute('aria-pressed', String(paused));
-  pause.textContent = paused ? 'Resume' : 'Pause';
+  pause.textContent = paused ? _('Resume') : _('Pause');
   held = 0;
   if (paused) render(); else reload();
 });

@@ -3,8 +3,9 @@
 // allowed; the page only mirrors it so an operator sees why a button is disabled.
 import { api, ApiError } from '../core/api.js';
 import { on } from '../live/live.js';
+import { _ } from '../core/i18n.js';
 
-const LIGHT_TEXT = { green: 'not running', red: 'running', unknown: 'unknown' };
+const LIGHT_TEXT = { green: _('not running'), red: _('running'), unknown: _('unknown') };
 
 const panelRoot = (id) => document.querySelector(`[data-panel="${CSS.escape(id)}"]`);
 const summaryRoot = (id) => document.querySelector(`[data-panel-summary="${CSS.escape(id)}"]`);
@@ -43,7 +44,7 @@ function refreshButton(root, button) {
 
 function showView(root, view) {
   root.dataset.locked = view.locked ? 'yes' : 'no';
-  root.querySelector('.cp-lock-state').textContent = view.locked ? 'Locked' : 'Unlocked';
+  root.querySelector('.cp-lock-state').textContent = view.locked ? _('Locked') : _('Unlocked');
   root.querySelector('[data-action="unlock"]').hidden = !view.locked;
   root.querySelector('[data-action="lock"]').hidden = view.locked;
   showLight(root, view.light);
@@ -60,7 +61,7 @@ function showView(root, view) {
 function showSummary(root, view) {
   showLight(root, view.light);
   showDisplays(root, view.displays);
-  root.querySelector('.cp-lock-state').textContent = view.locked ? 'locked' : 'unlocked';
+  root.querySelector('.cp-lock-state').textContent = view.locked ? _('locked') : _('unlocked');
 }
 
 on('panel', (data) => {
@@ -110,7 +111,7 @@ async function post(root, path, body) {
   try {
     reply = (await api('POST', url, body || {})) || {};
   } catch (err) {
-    say(root, err instanceof ApiError ? err.message : 'The server cannot be reached: nothing was sent.', true);
+    say(root, err instanceof ApiError ? err.message : _('The server cannot be reached: nothing was sent.'), true);
     return null;
   }
   if (reply.log) addLogEntry(reply.log);
@@ -123,16 +124,18 @@ async function sendControl(root, button) {
   const body = {};
   if (button.dataset.needsInput === 'yes') {
     const value = inputValue(root, id);
-    if (value === undefined) { say(root, `Enter a valid ${button.dataset.label} first.`, true); return; }
+    if (value === undefined) { say(root, _('Enter a valid %(what)s first.', { what: button.dataset.label }), true); return; }
     body.value = value;
   }
   if (button.dataset.confirm === 'yes') {
     const what = body.value === undefined ? button.dataset.label : `${button.dataset.label}: ${body.value}`;
-    if (!window.confirm(`Send "${what}"?`)) return;
+    if (!window.confirm(_('Send "%(what)s"?', { what }))) return;
     body.confirmed = true;
   }
   const reply = await post(root, id, body);
-  if (reply) say(root, `${button.dataset.label}: sent ${JSON.stringify(reply.value)} on ${reply.topic}`, false);
+  if (reply) {
+    say(root, _('%(what)s: sent %(value)s on %(topic)s', { what: button.dataset.label, value: JSON.stringify(reply.value), topic: reply.topic }), false);
+  }
 }
 
 document.addEventListener('click', (event) => {

@@ -2,6 +2,8 @@
 // axis for every series (uPlot.join aligns them), the page's colours and axes. A drag across the
 // chart selects (onSelect), a double click zooms out; `marker` draws a vertical line at a time.
 
+import { _ } from '../core/i18n.js';
+
 export const COLOURS = ['#58a6ff', '#e3b341', '#7ee787', '#ff7b72', '#d2a8ff', '#79c0ff', '#ffa657', '#a5d6ff'];
 export const MARKER_COLOUR = '#f85149';
 
@@ -49,7 +51,7 @@ export function seriesItems(ids, onRemove) {
     const remove = document.createElement('button');
     remove.type = 'button';
     remove.textContent = '×';
-    remove.title = `remove ${id}`;
+    remove.title = _('remove %(series)s', { series: id });
     remove.addEventListener('click', () => onRemove(id));
     li.append(remove);
     return li;

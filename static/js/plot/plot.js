@@ -5,6 +5,7 @@
 import { api, ApiError } from '../core/api.js';
 import { on } from '../live/live.js';
 import { chartWidth, joined, makeChart, seriesItems } from './chart.js';
+import { _ } from '../core/i18n.js';
 
 const KEEP = 20000;  // points per series kept in the page
 const $ = (id) => document.getElementById(id);
@@ -22,7 +23,7 @@ let drawPending = false;
 function showError(err) {
   const el = $('plot-error');
   if (!err) { el.hidden = true; return; }
-  el.textContent = err instanceof ApiError ? err.message : 'the server was not reached';
+  el.textContent = err instanceof ApiError ? err.message : _('the server was not reached');
   el.hidden = false;
 }
 
@@ -57,8 +58,8 @@ function tables(since) {
 function setPaused(value) {
   paused = value;
   pauseButton.setAttribute('aria-pressed', String(paused));
-  pauseButton.textContent = paused ? 'Resume' : 'Pause';
-  $('plot-state').textContent = paused ? 'paused' : 'live';
+  pauseButton.textContent = paused ? _('Resume') : _('Pause');
+  $('plot-state').textContent = paused ? _('paused') : _('live');
   if (!paused) rebuild();
 }
 
@@ -152,7 +153,7 @@ $('plot-form').addEventListener('submit', async (e) => {
   e.preventDefault();
   const topic = topicSelect.value;
   const field = fieldInput.value.trim();
-  if (!topic || !field) { showError(new ApiError(400, 'missing', 'choose a topic and a field')); return; }
+  if (!topic || !field) { showError(new ApiError(400, 'missing', _('choose a topic and a field'))); return; }
   try { await add(topic, field); showFailure(null); } catch (err) { showFailure(err); }
 });
 pauseButton.addEventListener('click', () => setPaused(!paused));

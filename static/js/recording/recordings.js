@@ -3,6 +3,7 @@
 // links. The list is read from GET /api/recordings every second while the page is open: one small
 // JSON a second, and no event channel to keep for a page few people have open.
 import { api, at, errorFrom } from '../core/api.js';
+import { _, ngettext, formatNumber, formatUnit, formatDateTime } from '../core/i18n.js';
 
 const $ = (id) => document.getElementById(id);
 const form = $('rec-form');
@@ -18,25 +19,26 @@ let running = null;  // the recording in progress, as the server last said
 let lastEnded = null;  // the id of the newest stopped recording, to say why it stopped
 
 function mb(bytes) {
-  return `${(bytes / (1024 * 1024)).toFixed(bytes < 10 * 1024 * 1024 ? 2 : 1)} MB`;
+  return formatUnit(bytes / (1024 * 1024), 'MB', bytes < 10 * 1024 * 1024 ? 2 : 1);
 }
 
 function duration(seconds) {
   const s = Math.round(seconds);
-  return s < 60 ? `${s} s` : `${Math.floor(s / 60)} min ${s % 60} s`;
+  return s < 60 ? formatUnit(s, 's') : `${formatUnit(Math.floor(s / 60), 'min')} ${formatUnit(s % 60, 's')}`;
 }
 
 const REASONS = {
-  requested: 'stopped', shutdown: 'stopped: the server shut down', max_size: 'stopped: it reached ROVER_WEB_RECORDING_MAX_MB',
-  folder_full: 'stopped: the recordings folder is full (ROVER_WEB_RECORDINGS_MAX_MB)',
-  disk_low: 'stopped: the disk is nearly full (ROVER_WEB_RECORDINGS_MIN_FREE_MB)',
-  write_error: 'stopped: it could not be written', subscribe_failed: 'stopped: a topic could not be subscribed to',
-  interrupted: 'interrupted: the server stopped without finishing it',
+  requested: _('stopped'), shutdown: _('stopped: the server shut down'),
+  max_size: _('stopped: it reached ROVER_WEB_RECORDING_MAX_MB'),
+  folder_full: _('stopped: the recordings folder is full (ROVER_WEB_RECORDINGS_MAX_MB)'),
+  disk_low: _('stopped: the disk is nearly full (ROVER_WEB_RECORDINGS_MIN_FREE_MB)'),
+  write_error: _('stopped: it could not be written'), subscribe_failed: _('stopped: a topic could not be subscribed to'),
+  interrupted: _('interrupted: the server stopped without finishing it'),
 };
 
 function stateText(rec) {
-  if (rec.state === 'recording') return 'recording';
-  if (rec.source === 'uploaded') return `uploaded by ${rec.started_by}`;
+  if (rec.state === 'recording') return _('recording');
+  if (rec.source === 'uploaded') return _('uploaded by %(name)s', { name: rec.started_by });
   return (REASONS[rec.stop_reason] || rec.state) + (rec.error ? ` (${rec.error})` : '');
 }
 
@@ -52,24 +54,24 @@ function row(rec) {
   tr.dataset.id = rec.id;
   tr.dataset.state = rec.state;
   tr.dataset.source = rec.source;
-  tr.append(cell(rec.name || rec.id), cell(new Date(rec.started_at * 1000).toLocaleString()),
-    cell(duration(rec.duration_s), 'num'), cell(mb(rec.size), 'num'), cell(String(Object.keys(rec.topics).length), 'num'),
-    cell(String(rec.messages), 'num'), cell(stateText(rec)));
+  tr.append(cell(rec.name || rec.id), cell(formatDateTime(rec.started_at * 1000)),
+    cell(duration(rec.duration_s), 'num'), cell(mb(rec.size), 'num'), cell(formatNumber(Object.keys(rec.topics).length), 'num'),
+    cell(formatNumber(rec.messages), 'num'), cell(stateText(rec)));
   const actions = document.createElement('td');
   if (rec.state !== 'recording') {
     const link = document.createElement('a');
     link.href = at(rec.file);
-    link.textContent = 'download';
+    link.textContent = _('download');
     link.setAttribute('download', '');
     const replay = document.createElement('a');
     replay.href = at(`/recordings/${rec.id}/replay`);
-    replay.textContent = 'replay';
+    replay.textContent = _('replay');
     actions.append(link, ' ', replay);
     if (canDelete) {
       const remove = document.createElement('button');
       remove.type = 'button';
       remove.className = 'rec-delete';
-      remove.textContent = 'delete';
+      remove.textContent = _('delete');
       remove.addEventListener('click', () => removeRecording(rec));
       actions.append(' ', remove);
     }
@@ -85,15 +87,18 @@ function showStatus(recordings) {
   if (running) {
     const dropped = Object.values(running.dropped).reduce((a, b) => a + b, 0);
     statusLine.dataset.state = 'recording';
-    statusLine.textContent = `Recording ${running.name || running.id}: ${duration(running.duration_s)}, `
-      + `${running.messages} messages, ${mb(running.size)}, ${Object.keys(running.topics).length} topics`
-      + (dropped ? `, ${dropped} dropped` : '');
+    // Each count a call of its own: Babel's extractor misses a call nested in another's arguments.
+    const messages = ngettext('%(num)d message', '%(num)d messages', running.messages);
+    const topics = ngettext('%(num)d topic', '%(num)d topics', Object.keys(running.topics).length);
+    statusLine.textContent = _('Recording %(name)s: %(duration)s, %(messages)s, %(size)s, %(topics)s', {
+      name: running.name || running.id, duration: duration(running.duration_s), size: mb(running.size), messages, topics,
+    }) + (dropped ? `, ${_('%(num)d dropped', { num: dropped })}` : '');
     return;
   }
   statusLine.dataset.state = 'idle';
   const newest = recordings[0];
   statusLine.textContent = newest && newest.id === lastEnded
-    ? `Not recording. ${newest.name || newest.id} ${stateText(newest)}.` : 'Not recording.';
+    ? _('Not recording. %(name)s %(state)s.', { name: newest.name || newest.id, state: stateText(newest) }) : _('Not recording.');
 }
 
 async function refresh() {
@@ -103,13 +108,13 @@ async function refresh() {
     showStatus(recordings);
     rows.replaceChildren(...(recordings.length ? recordings.map(row) : [emptyRow()]));
   } catch (err) {
-    statusLine.textContent = `The list could not be read: ${err.message}`;
+    statusLine.textContent = _('The list could not be read: %(reason)s', { reason: err.message });
   }
 }
 
 function emptyRow() {
   const tr = document.createElement('tr');
-  const td = cell('No recordings yet.', 'muted');
+  const td = cell(_('No recordings yet.'), 'muted');
   td.colSpan = 8;
   tr.append(td);
   return tr;
@@ -158,7 +163,7 @@ stopButton.addEventListener('click', async () => {
 });
 
 async function removeRecording(rec) {
-  if (!window.confirm(`Delete ${rec.name || rec.id} and its file?`)) return;
+  if (!window.confirm(_('Delete %(name)s and its file?', { name: rec.name || rec.id }))) return;
   showError(null);
   try {
     await api('DELETE', `/api/recordings/${rec.id}`);
@@ -178,12 +183,12 @@ $('rec-upload-form').addEventListener('submit', async (event) => {
   const most = Number($('rec-upload-form').dataset.maxBytes);
   if (file.size > most) {  // said here: a server refusing a large body early may reach the page as a reset
     said.dataset.state = 'refused';
-    said.textContent = `Not uploaded: ${file.name} is ${mb(file.size)}, over ROVER_WEB_RECORDING_UPLOAD_MAX_MB `
-      + `(${mb(most)}).`;
+    said.textContent = _('Not uploaded: %(file)s is %(size)s, over ROVER_WEB_RECORDING_UPLOAD_MAX_MB (%(most)s).',
+      { file: file.name, size: mb(file.size), most: mb(most) });
     return;
   }
   said.dataset.state = 'sending';
-  said.textContent = `Uploading ${file.name} (${mb(file.size)})…`;
+  said.textContent = _('Uploading %(file)s (%(size)s)…', { file: file.name, size: mb(file.size) });
   $('rec-upload').disabled = true;
   try {
     const response = await fetch(at(`/api/recordings/upload?${new URLSearchParams({ name })}`), {
@@ -191,11 +196,13 @@ $('rec-upload-form').addEventListener('submit', async (event) => {
     if (!response.ok) throw await errorFrom(response);
     const made = await response.json();
     said.dataset.state = 'done';
-    said.textContent = `${made.name || made.id} uploaded: ${made.messages} messages, ${duration(made.duration_s)}.`;
+    const messages = ngettext('%(num)d message', '%(num)d messages', made.messages);
+    said.textContent = _('%(name)s uploaded: %(messages)s, %(duration)s.',
+      { name: made.name || made.id, messages, duration: duration(made.duration_s) });
     $('rec-upload-form').reset();
   } catch (err) {
     said.dataset.state = 'refused';
-    said.textContent = `Not uploaded: ${err.message}`;
+    said.textContent = _('Not uploaded: %(reason)s', { reason: err.message });
   } finally {
     $('rec-upload').disabled = false;
   }

@@ -10,6 +10,7 @@ import { createDiagnostics } from './replay/diagnostics.js';
 import { createLiveMap } from './replay/livemap.js';
 import { createPlots } from './replay/plots.js';
 import { createTrack } from './replay/track.js';
+import { _, formatTime, formatUnit } from '../core/i18n.js';
 
 const $ = (id) => document.getElementById(id);
 const id = $('replay').dataset.id;
@@ -29,7 +30,7 @@ let lastFrame = 0;
 const span = () => data.end - data.start;
 
 function clock(t) {
-  return new Date(t * 1000).toLocaleTimeString();
+  return formatTime(t * 1000);
 }
 
 // The last SHOWN_LINES items at or before t, newest first (items are in time order).
@@ -45,7 +46,7 @@ function fillList(list, items, t, text) {
 function show() {
   const t = data.start + now;
   slider.value = span() > 0 ? Math.round((now / span()) * Number(slider.max)) : 0;
-  $('replay-time').textContent = `${clock(t)} (+${now.toFixed(1)} s of ${span().toFixed(1)} s)`;
+  $('replay-time').textContent = `${clock(t)} ${_('(+%(now)s of %(span)s)', { now: formatUnit(now, 's', 1), span: formatUnit(span(), 's', 1) })}`;
   $('replay').dataset.t = String(t);
   $('replay-tf').search = `?t=${t.toFixed(3)}`;  // the frames at the slider's time (rover_web/tf/replay.py)
   fillList($('replay-audit'), data.audit, t, (r) => `${r.by || '?'}: ${r.detail || r.action}`);
@@ -65,7 +66,7 @@ function frame(stamp) {
 
 function setPlaying(on) {
   playing = on;
-  playButton.textContent = on ? 'Pause' : 'Play';
+  playButton.textContent = on ? _('Pause') : _('Play');
   playButton.setAttribute('aria-pressed', String(on));
   lastFrame = 0;
   if (on) requestAnimationFrame(frame);
@@ -112,7 +113,7 @@ async function load() {
     return;
   }
   if (data.start === null) {
-    $('replay-time').textContent = 'this recording holds no message';
+    $('replay-time').textContent = _('this recording holds no message');
     return;
   }
   start();

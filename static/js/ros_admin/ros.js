@@ -4,6 +4,7 @@
 // may not use (a role below admin, read-only mode, a name the deny list refuses) are disabled with
 // the reason as their title; the server decides all the same.
 import { api, ApiError, at } from '../core/api.js';
+import { _ } from '../core/i18n.js';
 
 const layout = document.querySelector('.ros-layout');
 const writeBlock = layout.dataset.writeBlock || '';
@@ -35,8 +36,15 @@ function say(target, text, ok) {
   target.className = `${target.className.replace(/ ?ros-status-\w+/g, '')} ${ok ? 'ros-status-ok' : 'ros-status-error'}`;
 }
 
+// An action goal's state (ROS's GoalStatus names) in the page's language.
+const GOAL_STATUS = {
+  accepted: _('accepted'), executing: _('executing'), canceling: _('canceling'), succeeded: _('succeeded'),
+  canceled: _('canceled'), aborted: _('aborted'), unknown: _('unknown'),
+};
+const goalStatus = (s) => (s ? GOAL_STATUS[s] || s : '');
+
 function failure(err) {
-  return err instanceof ApiError ? `${err.code || err.status}: ${err.message}` : `not reached: ${err.message}`;
+  return err instanceof ApiError ? `${err.code || err.status}: ${err.message}` : _('not reached: %(reason)s', { reason: err.message });
 }
 
 // --- parameters ---
@@ -55,13 +63,13 @@ function parameterInput(p) {
   } else if (p.type === 'string') {
     input = el('input', { type: 'text', value: p.value });
   } else {
-    input = el('input', { type: 'text', value: JSON.stringify(p.value), title: `${p.type}, as JSON` });
+    input = el('input', { type: 'text', value: JSON.stringify(p.value), title: _('%(type)s, as JSON', { type: p.type }) });
   }
   input.name = p.name;
   input.disabled = p.read_only || p.hidden;
   if (p.hidden) {
     input.value = '';
-    input.placeholder = '(hidden: its name says it holds a secret)';
+    input.placeholder = _('(hidden: its name says it holds a secret)');
   }
   return input;
 }
@@ -76,7 +84,7 @@ function parameterValue(p, input) {
 async function loadParameters(details) {
   const box = details.querySelector('.ros-params');
   box.hidden = false;
-  box.textContent = 'loading…';
+  box.textContent = _('loading…');
   let reply;
   try {
     reply = await api('GET', `${nodeUrl(details.dataset.node)}/parameters`);
@@ -87,20 +95,20 @@ async function loadParameters(details) {
   const rows = reply.parameters.map((p) => {
     const input = parameterInput(p);
     const status = el('span', { className: 'ros-param-status small' });
-    const set = allowIf(el('button', { type: 'button', textContent: 'set' }),
-      (p.read_only && 'read-only: set only when the node starts') || writeBlock || p.refused
-      || (p.hidden && 'hidden value') || (reply.safety_node && estopEngaged()
-        && 'a safety node: its parameters stay as they are while the e-stop is engaged') || '');
+    const set = allowIf(el('button', { type: 'button', textContent: _('set') }),
+      (p.read_only && _('read-only: set only when the node starts')) || writeBlock || p.refused
+      || (p.hidden && _('hidden value')) || (reply.safety_node && estopEngaged()
+        && _('a safety node: its parameters stay as they are while the e-stop is engaged')) || '');
     set.addEventListener('click', async () => {
       let value;
-      try { value = parameterValue(p, input); } catch (err) { say(status, `not JSON: ${err.message}`, false); return; }
+      try { value = parameterValue(p, input); } catch (err) { say(status, _('not JSON: %(reason)s', { reason: err.message }), false); return; }
       try {
         await api('PUT', `${nodeUrl(details.dataset.node)}/parameters/${p.name}`, { value });
-        say(status, 'set', true);
+        say(status, _('set'), true);
       } catch (err) { say(status, failure(err), false); }
     });
     const label = el('td', {}, el('code', { textContent: p.name }));
-    label.title = [p.type, p.description, p.read_only ? 'read-only' : ''].filter(Boolean).join(' — ');
+    label.title = [p.type, p.description, p.read_only ? _('read-only') : ''].filter(Boolean).join(' — ');
     const tr = el('tr', {}, label, el('td', {}, input), el('td', {}, set, ' ', status));
     tr.dataset.param = p.name;
     return tr;
@@ -120,7 +128,7 @@ function fieldInputs(fields, prefix) {
     if (f.kind === 'bool') input = el('input', { type: 'checkbox' });
     else if (f.kind === 'int') input = el('input', { type: 'number', step: '1', min: String(f.min), max: String(f.max) });
     else if (f.kind === 'float') input = el('input', { type: 'number', step: 'any' });
-    else input = el('input', { type: 'text', placeholder: f.kind === 'array' ? `${f.type} as JSON` : f.type });
+    else input = el('input', { type: 'text', placeholder: f.kind === 'array' ? _('%(type)s as JSON', { type: f.type }) : f.type });
     input.dataset.path = path;
     input.dataset.kind = f.kind;
     return el('label', {}, `${f.name} `, input);
@@ -178,21 +186,21 @@ for (const row of document.querySelectorAll('.ros-service')) {
   const reason = writeBlock || row.dataset.refused;
   if (BUTTON_TYPES.has(type)) {
     const choices = type === 'std_srvs/srv/SetBool' ? [['true', { data: true }], ['false', { data: false }]]
-      : [['call', {}]];
+      : [[_('call'), {}]];
     for (const [text, request] of choices) {
       const button = allowIf(el('button', { type: 'button', textContent: text }), reason);
       button.addEventListener('click', () => callService(service, type, request));
       cell.append(button, ' ');
     }
   } else {
-    const open = allowIf(el('button', { type: 'button', textContent: 'form…' }), reason);
+    const open = allowIf(el('button', { type: 'button', textContent: _('form…') }), reason);
     open.addEventListener('click', async () => {
       open.remove();
       try {
         cell.append(await typeForm(type, 'request', (request, err) => {
-          if (err) say(serviceResult, `not JSON: ${err.message}`, false);
+          if (err) say(serviceResult, _('not JSON: %(reason)s', { reason: err.message }), false);
           else callService(service, type, request);
-        }, 'call'));
+        }, _('call')));
       } catch (err) { cell.append(failure(err)); }
     });
     cell.append(open);
@@ -211,18 +219,18 @@ let live = 0;
 function watchGoal(li, goal) {
   li.dataset.goal = goal.goal_id;
   if (live >= MAX_LIVE) {
-    const follow = el('button', { type: 'button', textContent: 'follow' });
+    const follow = el('button', { type: 'button', textContent: _('follow') });
     follow.addEventListener('click', () => { if (live < MAX_LIVE) watchGoal(li, goal); });
-    li.replaceChildren(el('code', { textContent: goal.action || goal.goal_id }), ' ', goal.status || '', ' ', follow);
+    li.replaceChildren(el('code', { textContent: goal.action || goal.goal_id }), ' ', goalStatus(goal.status), ' ', follow);
     return;
   }
   live += 1;
   let ended = false;
   const end = () => { if (!ended) { ended = true; live -= 1; } };
-  const status = el('span', { className: 'ros-goal-status', textContent: goal.status || '' });
+  const status = el('span', { className: 'ros-goal-status', textContent: goalStatus(goal.status) });
   const feedback = el('pre', { className: 'ros-goal-feedback' });
-  const cancel = allowIf(el('button', { type: 'button', textContent: 'cancel' }),
-    canCancel ? '' : 'canceling a goal needs the operator role');
+  const cancel = allowIf(el('button', { type: 'button', textContent: _('cancel') }),
+    canCancel ? '' : _('canceling a goal needs the operator role'));
   cancel.addEventListener('click', async () => {
     try { await api('POST', `/api/actions/${goal.goal_id}/cancel`, {}); } catch (err) { status.textContent = failure(err); }
   });
@@ -230,7 +238,7 @@ function watchGoal(li, goal) {
   const source = new EventSource(at(`/api/actions/${goal.goal_id}/events`));
   const show = (data) => {
     if (data.action) li.querySelector('code').textContent = data.action;
-    if (data.status) { status.textContent = data.status; li.dataset.status = data.status; }
+    if (data.status) { status.textContent = goalStatus(data.status); li.dataset.status = data.status; }
     if (data.feedback) feedback.textContent = JSON.stringify(data.feedback);
   };
   source.addEventListener('status', (e) => show(JSON.parse(e.data)));
@@ -238,7 +246,7 @@ function watchGoal(li, goal) {
   source.addEventListener('result', (e) => {
     const data = JSON.parse(e.data);
     show(data);
-    feedback.textContent = `result: ${JSON.stringify(data.result)}`;
+    feedback.textContent = _('result: %(result)s', { result: JSON.stringify(data.result) });
     cancel.remove();
     source.close();
     end();
@@ -259,15 +267,15 @@ for (const box of document.querySelectorAll('.ros-action')) {
     const result = el('span', { className: 'small' });
     try {
       box.append(await typeForm(box.dataset.type, 'goal', async (goal, err) => {
-        if (err) { say(result, `not JSON: ${err.message}`, false); return; }
+        if (err) { say(result, _('not JSON: %(reason)s', { reason: err.message }), false); return; }
         try {
           const sent = await api('POST', '/api/actions/goal', { action: box.dataset.action, type: box.dataset.type, goal });
-          say(result, `accepted ${sent.goal_id}`, true);
+          say(result, _('accepted %(goal)s', { goal: sent.goal_id }), true);
           const li = el('li');
           goalsList.prepend(li);
           watchGoal(li, sent);
         } catch (e) { say(result, failure(e), false); }
-      }, 'send goal'), result);
+      }, _('send goal')), result);
     } catch (err) { box.append(failure(err)); }
   });
 }

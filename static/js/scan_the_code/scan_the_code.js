@@ -2,8 +2,21 @@
 // Every string from the robot is set with textContent; colour names become CSS values only when
 // they are one of the configured colours (or black).
 import { on, onServerState } from '../live/live.js';
+import { _, formatNumber, formatTime } from '../core/i18n.js';
 
 const card = document.getElementById('scan-the-code');
+// The usual colour names in the page's language; a colour configured under another name shows as
+// it is configured (ROVER_WEB settings). The data-colour attributes keep the configured names.
+const COLOUR_WORDS = {
+  red: _('red'), green: _('green'), blue: _('blue'), yellow: _('yellow'), white: _('white'), black: _('black'),
+  orange: _('orange'), purple: _('purple'),
+};
+// Why a cycle made no code, and what it made (rover_web/scan_the_code/light_sequence.py).
+const PROBLEMS = {
+  unknown_colour: _('unknown colour'), too_many_colours: _('too many colours'), too_few_colours: _('too few colours'),
+  stream_gap: _('stream gap'),
+};
+const RESULTS = { invalid: _('invalid'), incomplete: _('incomplete') };
 const TOWER_KEY = 'rover_web.scan_the_code.tower_hidden';
 
 if (card) {
@@ -18,8 +31,9 @@ if (card) {
   };
   // The server-rendered colours too: the Content-Security-Policy allows no inline style attributes.
   for (const el of card.querySelectorAll('[data-colour]')) paint(el, el.dataset.colour);
-  const problemsText = (list) => list.join(', ').replaceAll('_', ' ');
-  const clock = (epochS) => new Date(epochS * 1000).toLocaleTimeString([], { hour12: false });
+  const problemsText = (list) => list.map((p) => PROBLEMS[p] || p.replaceAll('_', ' ')).join(', ');
+  const clock = (epochS) => formatTime(epochS * 1000, { hour: '2-digit', minute: '2-digit', second: '2-digit', hourCycle: 'h23' });
+  const colourWord = (c) => COLOUR_WORDS[c] || c;
   const span = (cls, text) => {
     const el = document.createElement('span');
     el.className = cls;
@@ -29,7 +43,7 @@ if (card) {
 
   const setFresh = (state) => {
     const pill = $('stc-fresh');
-    const labels = { ok: 'live', stale: 'stale', no_data: 'no data', unknown: 'unknown' };
+    const labels = { ok: _('live'), stale: _('stale'), no_data: _('no data'), unknown: _('unknown') };
     pill.dataset.state = state;
     pill.querySelector('b').textContent = labels[state];
     card.classList.toggle('stc-stale', state !== 'ok');
@@ -40,17 +54,18 @@ if (card) {
     const code = $('stc-code');
     code.dataset.confirmed = s.code && s.code.confirmed ? 'yes' : 'no';
     if (!s.code) {
-      code.replaceChildren(span('stc-none', 'no code yet'));
-      $('stc-code-meta').textContent = 'waiting for three colours and black';
+      code.replaceChildren(span('stc-none', _('no code yet')));
+      $('stc-code-meta').textContent = _('waiting for three colours and black');
       return;
     }
     code.replaceChildren(...s.code.colours.map((c) => {
-      const chip = span('stc-chip', c);
+      const chip = span('stc-chip', colourWord(c));
       paint(chip, c);
       return chip;
     }));
-    const pending = s.code.confirmed ? '' : ` (confirmed at ${s.confirm_cycles})`;
-    $('stc-code-meta').textContent = `confidence ${s.code.confidence}${pending} · seen ${clock(s.code.seen_at)}`;
+    const confidence = _('confidence %(n)s', { n: s.code.confidence });
+    const pending = s.code.confirmed ? '' : ` ${_('(confirmed at %(n)s)', { n: s.confirm_cycles })}`;
+    $('stc-code-meta').textContent = `${confidence}${pending} · ${_('seen %(time)s', { time: clock(s.code.seen_at) })}`;
   };
 
   const renderBoxes = (s) => {
@@ -58,17 +73,17 @@ if (card) {
     s.boxes.forEach((c, i) => {
       if (!boxes[i]) return;
       paint(boxes[i], c);
-      boxes[i].querySelector('.stc-box-name').textContent = c;
+      boxes[i].querySelector('.stc-box-name').textContent = c === null ? '' : colourWord(c);
     });
     const note = $('stc-cycle');
     note.dataset.problem = s.cycle.problems.length ? 'yes' : 'no';
-    note.textContent = s.cycle.problems.length ? `this cycle is invalid: ${problemsText(s.cycle.problems)}` : '';
+    note.textContent = s.cycle.problems.length ? _('this cycle is invalid: %(problems)s', { problems: problemsText(s.cycle.problems) }) : '';
   };
 
   const renderLight = (s) => {
     paint($('stc-lamp'), s.light);
-    $('stc-light').textContent = s.light === null ? 'no message yet'
-      : s.light === 'unknown' ? `unknown: ${s.light_text}` : s.light;
+    $('stc-light').textContent = s.light === null ? _('no message yet')
+      : s.light === 'unknown' ? _('unknown: %(text)s', { text: s.light_text }) : colourWord(s.light);
   };
 
   const renderHistory = (s) => {
@@ -76,8 +91,8 @@ if (card) {
       const li = document.createElement('li');
       li.dataset.result = h.result;
       const extra = h.length > h.colours.length ? ` (+${h.length - h.colours.length})` : '';
-      li.append(span('stc-when', clock(h.at)), ' ', span('stc-what', h.colours.join(', ') + extra), ' ',
-        span('stc-result', h.result === 'code' ? 'code' : `${h.result}: ${problemsText(h.problems)}`));
+      li.append(span('stc-when', clock(h.at)), ' ', span('stc-what', h.colours.map(colourWord).join(', ') + extra), ' ',
+        span('stc-result', h.result === 'code' ? _('code') : `${RESULTS[h.result] || h.result}: ${problemsText(h.problems)}`));
       return li;
     }));
   };
@@ -90,9 +105,9 @@ if (card) {
     renderCode(s);
     renderBoxes(s);
     renderLight(s);
-    $('stc-unknown').textContent = String(s.counts.unknown_messages);
-    $('stc-invalid').textContent = String(s.counts.invalid_cycles);
-    $('stc-incomplete').textContent = String(s.counts.incomplete_cycles);
+    $('stc-unknown').textContent = formatNumber(s.counts.unknown_messages);
+    $('stc-invalid').textContent = formatNumber(s.counts.invalid_cycles);
+    $('stc-incomplete').textContent = formatNumber(s.counts.incomplete_cycles);
     renderHistory(s);
     setFresh(freshness(s));
   });
@@ -108,7 +123,7 @@ if (card) {
   const tower = $('stc-tower');
   const showTower = (visible) => {
     tower.hidden = !visible;
-    toggle.textContent = visible ? 'Hide' : 'Show';
+    toggle.textContent = visible ? _('Hide') : _('Show');
     toggle.setAttribute('aria-expanded', String(visible));
   };
   let stored = null;

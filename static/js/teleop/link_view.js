@@ -3,7 +3,12 @@
 // judges the link too poor to drive. The figures and the verdict are the server's
 // (rover_web/teleop/link.py): the page only shows them.
 
-const ms = (v) => (v === null || v === undefined ? '—' : `${Math.round(v)} ms`);
+import { _, formatNumber, formatUnit } from '../core/i18n.js';
+
+const ms = (v) => (v === null || v === undefined ? '—' : formatUnit(Math.round(v), 'ms'));
+
+// The server's verdict words (rover_web/teleop/link.py), as the card says them.
+const QUALITY = { ok: _('ok'), poor: _('poor'), too_poor: _('too poor') };
 
 export function linkView(root = document) {
   const $ = (id) => root.getElementById(id);
@@ -16,11 +21,13 @@ export function linkView(root = document) {
     box.dataset.quality = link.quality;
     set('teleop-rtt', ms(link.rtt_ms));
     set('teleop-jitter', ms(link.jitter_ms));
-    set('teleop-stalls', link.stalls ? `${link.stalls} (longest ${ms(link.last_stall_ms)})` : '0');
-    set('teleop-quality', link.quality === 'too_poor' ? 'too poor' : link.quality);
+    set('teleop-stalls', link.stalls
+      ? _('%(stalls)s (longest %(longest)s)', { stalls: formatNumber(link.stalls), longest: ms(link.last_stall_ms) })
+      : formatNumber(0));
+    set('teleop-quality', QUALITY[link.quality] || link.quality);
     if (banner) {
       banner.hidden = link.quality !== 'too_poor';
-      banner.textContent = link.quality === 'too_poor' ? `Link too poor to drive safely: ${link.why}` : '';
+      banner.textContent = link.quality === 'too_poor' ? _('Link too poor to drive safely: %(why)s', { why: link.why }) : '';
     }
   }
 

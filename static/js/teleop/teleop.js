@@ -13,6 +13,16 @@ import { startGamepad } from './teleop_gamepad.js';
 import { setEstopSender } from './teleop_link.js';
 import { teleopChannel } from '../camera/teleop_channel.js';
 import { linkView } from './link_view.js';
+import { _, formatNumber, formatUnit } from '../core/i18n.js';
+
+const REARM = _('E-stop released: let go of the stick, keys or gamepad to re-arm.');
+// The server's words for what drives and why it last stopped (rover_web/teleop/control.py).
+const SOURCES = { joystick: _('joystick'), keyboard: _('keyboard'), gamepad: _('gamepad') };
+const STOP_REASONS = {
+  operator: _('operator'), disconnected: _('disconnected'), taken_over: _('taken over'), released: _('released'),
+  rest_stop: _('stop request'), estop: _('e-stop'), link_lost: _('link lost'), duration_elapsed: _('duration elapsed'),
+  deadman: _('deadman'), bad_input: _('bad input'),
+};
 
 const card = document.getElementById('teleop-card');
 if (card) start();
@@ -56,13 +66,13 @@ function start() {
   // The server decides who may drive; a viewer's page does not even open the socket.
   if (document.body.dataset.canOperate === 'no') {
     card.dataset.mode = 'read-only';
-    text('teleop-link', 'view only');
-    message(card.dataset.readonlyReason || 'Driving needs the operator role.');
-    text('gamepad-name', 'view only');
+    text('teleop-link', _('view only'));
+    message(card.dataset.readonlyReason || _('Driving needs the operator role.'));
+    text('gamepad-name', _('view only'));
     on('teleop', (s) => {
-      text('teleop-linear', s.linear_mps.toFixed(2));
-      text('teleop-angular', s.angular_rps.toFixed(2));
-      text('teleop-holder', s.holder ? s.holder.name : 'free');
+      text('teleop-linear', formatNumber(s.linear_mps, 2));
+      text('teleop-angular', formatNumber(s.angular_rps, 2));
+      text('teleop-holder', s.holder ? s.holder.name : _('free'));
     });
     return;
   }
@@ -174,12 +184,12 @@ function start() {
   function render() {
     const mode = estop ? 'estop' : inControl ? 'driving' : holder ? 'view-only' : 'free';
     card.dataset.mode = mode;
-    text('teleop-holder', inControl ? `you (${holder ? holder.name : operatorName()})`
-      : holder ? `${holder.name} (view only)` : 'free');
+    text('teleop-holder', inControl ? _('you (%(name)s)', { name: holder ? holder.name : operatorName() })
+      : holder ? _('%(name)s (view only)', { name: holder.name }) : _('free'));
     $('teleop-takeover').hidden = !(holder && !inControl) || !session;
     $('teleop-release').hidden = !inControl;
-    if (estop) message('E-stop engaged: release it to drive.');
-    else if (mode === 'view-only') message(`${holder.name} is driving. Take control to drive.`);
+    if (estop) message(_('E-stop engaged: release it to drive.'));
+    else if (mode === 'view-only') message(_('%(name)s is driving. Take control to drive.', { name: holder.name }));
   }
 
   function onServerMessage(m) {
@@ -193,7 +203,8 @@ function start() {
       link.dataset.state = 'live';
       transport = m.transport || 'websocket';
       link.dataset.transport = transport;  // the camera's data channel, when it is up
-      link.textContent = `connected as ${m.name}${m.transport === 'datachannel' ? ' (data channel)' : ''}`;
+      link.textContent = m.transport === 'datachannel' ? _('connected as %(name)s (data channel)', { name: m.name })
+        : _('connected as %(name)s', { name: m.name });
     }
     if (m.link) linkFigures.show(m.link);
     // The periodic report: nothing changed, unless it names a newer epoch. Over the data channel a
@@ -205,16 +216,16 @@ function start() {
       inControl = m.in_control;
       holder = live(m.holder);
       estop = m.estop;
-      if (m.reason === 'deadman') message('Stopped: no input reached the server in time.');
-      else if (m.reason === 'taken_over' && !inControl) message('Another operator took control.');
+      if (m.reason === 'deadman') message(_('Stopped: no input reached the server in time.'));
+      else if (m.reason === 'taken_over' && !inControl) message(_('Another operator took control.'));
       else if (m.reason === 'in_control') message('');
       else if (m.reason === 'estop_released') {
-        message(m.armed === false && wanted() ? 'E-stop released: let go of the stick, keys or gamepad to re-arm.' : '');
+        message(m.armed === false && wanted() ? REARM : '');
       }
       render();
       if (wanted()) sendDrive();  // still held: the new epoch makes this a fresh, live input
     } else if (m.type === 'error' && m.error === 'rearm_required') {
-      message('E-stop released: let go of the stick, keys or gamepad to re-arm.');
+      message(REARM);
     } else if (m.type === 'error' && !['stale_epoch', 'stale_seq', 'late_frame'].includes(m.error)) {
       message(m.message);
     }
@@ -245,7 +256,7 @@ function start() {
       driving = false;
       const link = $('teleop-link');
       link.dataset.state = 'reconnecting';
-      link.textContent = 'reconnecting';
+      link.textContent = _('reconnecting');
       linkFigures.clear();
       render();
       setTimeout(connect, retryMs);
@@ -321,7 +332,7 @@ function start() {
   const speed = $('teleop-key-speed');
   speed.addEventListener('input', () => {
     keySpeed = Number(speed.value) / 100;
-    text('teleop-key-speed-out', `${speed.value}%`);
+    text('teleop-key-speed-out', formatUnit(Number(speed.value), '%'));
   });
   const name = $('teleop-name');
   name.value = operatorName();
@@ -333,10 +344,10 @@ function start() {
   // --- what everyone sees ---
 
   on('teleop', (s) => {
-    text('teleop-linear', s.linear_mps.toFixed(2));
-    text('teleop-angular', s.angular_rps.toFixed(2));
-    text('teleop-source', s.source || '');
-    text('teleop-last-stop', s.last_stop ? s.last_stop.reason.replaceAll('_', ' ') : '—');
+    text('teleop-linear', formatNumber(s.linear_mps, 2));
+    text('teleop-angular', formatNumber(s.angular_rps, 2));
+    text('teleop-source', s.source ? SOURCES[s.source] || s.source : '');
+    text('teleop-last-stop', s.last_stop ? STOP_REASONS[s.last_stop.reason] || s.last_stop.reason.replaceAll('_', ' ') : '—');
     // Who holds control, for display and for claiming a free robot. Whether *this* socket holds it
     // comes from the socket itself: an SSE update can be a little older than the socket's news.
     if (!inControl) holder = live(s.holder);

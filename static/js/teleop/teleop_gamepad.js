@@ -9,6 +9,7 @@
 // and pressed again. If the reading stalls while a command is held (no animation frame for
 // STALE_MS), the command ends as well: a frozen reading must not be repeated as a held input.
 import { DEFAULTS, EnableGate, normalizeConfig, pace, readPad } from './gamepad.js';
+import { _, formatNumber } from '../core/i18n.js';
 
 const KEY = 'rover_web.gamepad';
 const STALE_MS = 200;
@@ -72,7 +73,7 @@ export function startGamepad({ onChange, sentAt }) {
     if (handed) hand(null);
     const next = pads()[0];
     if (next) index = next.index;
-    else showIdle('none', 'none connected: press a button on it');
+    else showIdle('none', _('none connected: press a button on it'));
     schedule();
   }
 
@@ -89,9 +90,10 @@ export function startGamepad({ onChange, sentAt }) {
     const want = gate.command(reading);
     if (pace(handed, want, now, sentAt(), periodMs)) hand(want);
     mark(want ? 'driving' : gate.blocked ? 'blocked' : reading.enable ? 'enabled' : 'connected');
-    text('gamepad-name', pad.mapping === 'standard' ? pad.id : `${pad.id} (not standard mapping: check the axes)`);
-    text('gamepad-enable', reading.enable ? (gate.blocked ? 'held: let go and press again' : 'held') : 'released');
-    text('gamepad-stick', `linear ${reading.linear.toFixed(2)}, angular ${reading.angular.toFixed(2)}`);
+    text('gamepad-name', pad.mapping === 'standard' ? pad.id : _('%(pad)s (not standard mapping: check the axes)', { pad: pad.id }));
+    text('gamepad-enable', reading.enable ? (gate.blocked ? _('held: let go and press again') : _('held')) : _('released'));
+    text('gamepad-stick', _('linear %(linear)s, angular %(angular)s',
+      { linear: formatNumber(reading.linear, 2), angular: formatNumber(reading.angular, 2) }));
     schedule();
   }
 
@@ -151,7 +153,7 @@ export function startGamepad({ onChange, sentAt }) {
   fill();
 
   if (!available) {
-    showIdle('unavailable', 'unavailable: browsers expose gamepads only on secure pages (localhost or HTTPS)');
+    showIdle('unavailable', _('unavailable: browsers expose gamepads only on secure pages (localhost or HTTPS)'));
     return { command: () => null, suppress() {}, setRate() {} };
   }
 
@@ -171,7 +173,7 @@ export function startGamepad({ onChange, sentAt }) {
   });
   const first = pads()[0];
   if (first) index = first.index;
-  else showIdle('none', 'none connected: press a button on it');
+  else showIdle('none', _('none connected: press a button on it'));
   schedule();
 
   return {

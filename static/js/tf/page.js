@@ -4,6 +4,10 @@
 import { on } from '../live/live.js';
 import { api } from '../core/api.js';
 import { showTree } from './tree.js';
+import { _, formatNumber, formatUnit } from '../core/i18n.js';
+
+// A ROS stamp: seconds since 1970, never grouped in thousands.
+const STAMP = { minimumFractionDigits: 3, maximumFractionDigits: 3, useGrouping: false };
 
 const $ = (id) => document.getElementById(id);
 const card = $('tf');
@@ -37,12 +41,13 @@ $('tf-lookup').addEventListener('submit', async (event) => {
     const [x, y, z] = tf.translation;
     const [qx, qy, qz, qw] = tf.rotation;
     out.dataset.error = 'false';
-    out.textContent = `translation ${x.toFixed(3)} ${y.toFixed(3)} ${z.toFixed(3)} m · rotation (x y z w) `
-      + `${qx.toFixed(4)} ${qy.toFixed(4)} ${qz.toFixed(4)} ${qw.toFixed(4)} · yaw ${(tf.yaw * 180 / Math.PI).toFixed(1)}° `
-      + `· at ${tf.stamp.toFixed(3)} s`;
+    const n = (v, digits) => formatNumber(v, digits);
+    out.textContent = _('translation %(x)s %(y)s %(z)s m · rotation (x y z w) %(qx)s %(qy)s %(qz)s %(qw)s · yaw %(yaw)s · at %(stamp)s', {
+      x: n(x, 3), y: n(y, 3), z: n(z, 3), qx: n(qx, 4), qy: n(qy, 4), qz: n(qz, 4), qw: n(qw, 4),
+      yaw: formatUnit(tf.yaw * 180 / Math.PI, '°', 1), stamp: formatUnit(tf.stamp, 's', STAMP) });
   } catch (err) {
     out.dataset.error = 'true';
-    out.textContent = err.code ? `${err.code}: ${err.message}` : `not reached: ${err.message}`;
+    out.textContent = err.code ? `${err.code}: ${err.message}` : _('not reached: %(reason)s', { reason: err.message });
   }
 });
 

@@ -2,12 +2,16 @@
 // tree in the replay view): each frame a box under its parent as view_frames draws it, the edge
 // labelled static or its rate and age, the warnings, and the picked frame's details. Pure DOM.
 
-const fmt = (v, digits = 2, unit = '') => (v === null || v === undefined ? '–' : `${Number(v).toFixed(digits)}${unit}`);
+import { _, ngettext, formatNumber, formatUnit } from '../core/i18n.js';
+
+// A ROS stamp: seconds since 1970, never grouped in thousands.
+const STAMP = { minimumFractionDigits: 3, maximumFractionDigits: 3, useGrouping: false };
+const fmt = (v, digits = 2, unit = '') => (v === null || v === undefined ? '–' : unit ? formatUnit(v, unit, digits) : formatNumber(v, digits));
 
 function edgeLabel(f) {
   if (f.parent === null) return '';
-  if (f.static) return 'static';
-  return `${fmt(f.rate_hz, 1, ' Hz')} · ${fmt(f.age_s, 2, ' s')} old`;
+  if (f.static) return _('static');
+  return _('%(rate)s · %(age)s old', { rate: fmt(f.rate_hz, 1, 'Hz'), age: fmt(f.age_s, 2, 's') });
 }
 
 function warned(tree) {
@@ -56,12 +60,12 @@ function branch(name, tree, state, seen) {
 function details(name, f) {
   const dl = document.createElement('dl');
   const rows = [
-    ['frame', name], ['parent', f.parent ?? '(root)'],
-    ['kind', f.static === null ? '(only a parent)' : (f.static ? 'static' : 'dynamic')],
-    ['rate', fmt(f.rate_hz, 1, ' Hz')], ['age', fmt(f.age_s, 3, ' s')],
-    ['newest stamp', fmt(f.newest_stamp, 3, ' s')], ['oldest kept', fmt(f.oldest_stamp, 3, ' s')],
-    ['authority', f.authority || '–'], ['received', String(f.received)],
-    ['refused (unnormalised)', String(f.unnormalised)], ['children', (f.children || []).join(', ') || '–'],
+    [_('frame'), name], [_('parent'), f.parent ?? _('(root)')],
+    [_('kind'), f.static === null ? _('(only a parent)') : (f.static ? _('static') : _('dynamic'))],
+    [_('rate'), fmt(f.rate_hz, 1, 'Hz')], [_('age'), fmt(f.age_s, 3, 's')],
+    [_('newest stamp'), fmt(f.newest_stamp, STAMP, 's')], [_('oldest kept'), fmt(f.oldest_stamp, STAMP, 's')],
+    [_('authority'), f.authority || '–'], [_('received'), formatNumber(f.received)],
+    [_('refused (unnormalised)'), formatNumber(f.unnormalised)], [_('children'), (f.children || []).join(', ') || '–'],
   ];
   for (const [k, v] of rows) {
     const dt = document.createElement('dt');
@@ -79,7 +83,8 @@ export function showTree(tree, where, state) {
   state.warned = warned(tree);
   const names = Object.keys(tree.frames);
   where.empty.hidden = names.length > 0;
-  where.summary.textContent = names.length ? `${names.length} frames, ${tree.roots.length} root(s)` : '';
+  where.summary.textContent = names.length ? `${ngettext('%(num)d frame', '%(num)d frames', names.length)}, `
+    + ngettext('%(num)d root', '%(num)d roots', tree.roots.length) : '';
   where.warnings.replaceChildren(...tree.warnings.map((w) => {
     const li = document.createElement('li');
     li.dataset.kind = w.kind;

@@ -3,6 +3,7 @@
 // hidden, so the server removes the subscription when nobody looks).
 import { at, errorFrom } from '../core/api.js';
 import { on } from '../live/live.js';
+import { formatNumber, formatUnit } from '../core/i18n.js';
 
 const body = document.getElementById('topics-body');
 const filter = document.getElementById('topics-filter');
@@ -56,19 +57,19 @@ function markSelected() {
 }
 
 function human(bytesPerS) {
-  if (bytesPerS >= 1e6) return `${(bytesPerS / 1e6).toFixed(2)} MB/s`;
-  if (bytesPerS >= 1e3) return `${(bytesPerS / 1e3).toFixed(1)} kB/s`;
-  return `${bytesPerS.toFixed(0)} B/s`;
+  if (bytesPerS >= 1e6) return formatUnit(bytesPerS / 1e6, 'MB/s', 2);
+  if (bytesPerS >= 1e3) return formatUnit(bytesPerS / 1e3, 'kB/s', 1);
+  return formatUnit(bytesPerS, 'B/s', 0);
 }
 
 function showStats(d) {
   const s = d.stats;
   $('echo-type').textContent = d.type;
   $('echo-qos').textContent = d.qos;
-  $('echo-rate').textContent = `${s.rate_hz.toFixed(2)} Hz`;
+  $('echo-rate').textContent = formatUnit(s.rate_hz, 'Hz', 2);
   $('echo-bw').textContent = human(s.bandwidth_bps);
-  $('echo-size').textContent = s.size_bytes === null ? '—' : `${s.size_bytes} B`;
-  $('echo-count').textContent = String(s.count);
+  $('echo-size').textContent = s.size_bytes === null ? '—' : formatUnit(s.size_bytes, 'B', 0);
+  $('echo-count').textContent = formatNumber(s.count);
   const isImage = imageTypes.has(d.type);
   $('echo-stream').hidden = !isImage;
   if (isImage) $('echo-stream-link').href = at(`/stream?topic=${encodeURIComponent(d.topic)}`);

@@ -4,6 +4,7 @@
 // joint tree, and a link TF does not know keeps its pose from the URDF (zero joints) under the root.
 import * as THREE from './three.js';
 import { at } from '../core/api.js';
+import { _ } from '../core/i18n.js';
 
 const MESH_LOADERS = {
   stl: (url, manager, material, done) => new THREE.STLLoader(manager).load(url,
@@ -47,14 +48,14 @@ export class RobotModel {
     loader.loadMeshCb = (url, mgr, material, done) => {
       const kind = (url.match(/\.(\w+)$/) || [])[1]?.toLowerCase();
       if (!url.startsWith(meshBase + '/') || !MESH_LOADERS[kind]) {
-        this.meshErrors.push(`${url}: only package:// meshes (STL, DAE, OBJ) are drawn`);
+        this.meshErrors.push(_('%(url)s: only package:// meshes (STL, DAE, OBJ) are drawn', { url }));
         done(null);
         return;
       }
       this.pending += 1;
       MESH_LOADERS[kind](url, mgr, material, (mesh, err) => {
         this.pending -= 1;
-        if (err || !mesh) this.meshErrors.push(`${url}: ${err?.message || 'not loaded'}`);
+        if (err || !mesh) this.meshErrors.push(`${url}: ${err?.message || _('not loaded')}`);
         done(mesh, err);
       });
     };

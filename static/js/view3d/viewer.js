@@ -11,6 +11,7 @@ import { Overlays } from './overlays.js';
 import { Poses } from './poses.js';
 import { RobotModel } from './robot.js';
 import { TfAxes } from './tf_axes.js';
+import { _, ngettext } from '../core/i18n.js';
 
 export function webglMissing() {
   try {
@@ -85,7 +86,7 @@ export class Viewer {
     try {
       description = await api('GET', '/api/3d/robot');
     } catch (err) {
-      this.status(`the robot's description was not read: ${err.message}`, 'error');
+      this.status(_("the robot's description was not read: %(reason)s", { reason: err.message }), 'error');
       return;
     }
     this.robotSeq = description.seq || 0;
@@ -95,13 +96,16 @@ export class Viewer {
     this.overlays.mapFrame = description.map_frame || 'map';
     this.updateCloud();  // the cloud needs only its topic, not a good model
     if (description.state === 'waiting') { this.status(description.message, 'waiting'); return; }
-    if (description.state === 'error') { this.status(`URDF refused: ${description.error.message}`, 'error'); return; }
+    if (description.state === 'error') { this.status(_('URDF refused: %(reason)s', { reason: description.error.message }), 'error'); return; }
     await this.layers.robot.build(description);
     this.container.dataset.robot = description.name;
     this.container.dataset.links = String(this.layers.robot.links.size);
     const meshErrors = this.layers.robot.meshErrors;
-    this.status(meshErrors.length ? `${description.name}: ${meshErrors.length} mesh(es) not drawn: ${meshErrors[0]}`
-      : `${description.name}: ${this.layers.robot.links.size} links`, meshErrors.length ? 'warn' : 'ok');
+    this.status(meshErrors.length
+      ? ngettext('%(robot)s: %(num)d mesh not drawn: %(first)s', '%(robot)s: %(num)d meshes not drawn: %(first)s', meshErrors.length,
+        { robot: description.name, first: meshErrors[0] })
+      : ngettext('%(robot)s: %(num)d link', '%(robot)s: %(num)d links', this.layers.robot.links.size, { robot: description.name }),
+    meshErrors.length ? 'warn' : 'ok');
     this.container.dataset.meshErrors = String(meshErrors.length);
     this.placeAll();
   }

@@ -8,6 +8,7 @@ import { attachGeofence } from '../geofence/geofence_map.js';
 import { createGpsMap, fmtLatLng } from '../gps/gps_map.js';
 import { loadMaplibre } from '../core/vendor.js';
 import { ROBOT_LAYERS, ROBOT_SOURCES, createRobot } from '../gps/robot.js';
+import { _, ngettext, formatNumber } from '../core/i18n.js';
 
 const el = document.getElementById('wp-map');
 if (el) init(el);
@@ -30,7 +31,7 @@ function init(container) {
     if (!mission || (!force && mission.revision < state.mission.revision)) return;
     state.mission = mission;
     list.dataset.revision = String(mission.revision);
-    $('wp-count').textContent = String(mission.waypoints.length);
+    $('wp-count').textContent = formatNumber(mission.waypoints.length);
     list.replaceChildren(...mission.waypoints.map((w, i) => listItem(w, i, mission.waypoints.length)));
     if (map) drawMarkers(mission.waypoints);
   }
@@ -58,9 +59,9 @@ function init(container) {
       b.addEventListener('click', fn);
       buttons.append(b);
     };
-    button('↑', 'earlier in the mission', () => edit('PATCH', w.id, { index: i - 1 }), i === 0);
-    button('↓', 'later in the mission', () => edit('PATCH', w.id, { index: i + 1 }), i === n - 1);
-    button('✕', 'delete this waypoint', () => edit('DELETE', w.id));
+    button('↑', _('earlier in the mission'), () => edit('PATCH', w.id, { index: i - 1 }), i === 0);
+    button('↓', _('later in the mission'), () => edit('PATCH', w.id, { index: i + 1 }), i === n - 1);
+    button('✕', _('delete this waypoint'), () => edit('DELETE', w.id));
     li.append(num, label, coords, buttons);
     return li;
   }
@@ -107,20 +108,20 @@ function init(container) {
     const box = document.createElement('div');
     box.className = 'wp-popup';
     const title = document.createElement('strong');
-    title.textContent = `Waypoint ${i + 1}${w.label ? `: ${w.label}` : ''}`;
+    title.textContent = w.label ? _('Waypoint %(n)d: %(label)s', { n: i + 1, label: w.label }) : _('Waypoint %(n)d', { n: i + 1 });
     const where = document.createElement('div');
     where.textContent = fmtLatLng(w.lat, w.lng);
     const del = document.createElement('button');
     del.type = 'button';
     del.className = 'danger';
-    del.textContent = 'Delete';
+    del.textContent = _('Delete');
     del.addEventListener('click', () => edit('DELETE', w.id));
     box.append(title, where, del);
     return new maplibregl.Popup({ offset: 16, closeButton: true }).setDOMContent(box);
   }
 
   async function refresh() {
-    try { render(await api('GET', '/api/waypoints')); } catch (err) { say(`Could not reload the list: ${err.message}`, 'error'); }
+    try { render(await api('GET', '/api/waypoints')); } catch (err) { say(_('Could not reload the list: %(reason)s', { reason: err.message }), 'error'); }
   }
 
   async function edit(method, id, body) {
@@ -138,7 +139,7 @@ function init(container) {
     const { lng, lat } = lngLat.wrap();
     try {
       const res = await api('POST', '/waypoints', { lng, lat });
-      say(`Waypoint ${res.waypoint.index + 1} added at ${fmtLatLng(res.waypoint.lat, res.waypoint.lng)}`);
+      say(_('Waypoint %(n)d added at %(position)s', { n: res.waypoint.index + 1, position: fmtLatLng(res.waypoint.lat, res.waypoint.lng) }));
     } catch (err) {
       say(err.message, 'error');
     }
@@ -148,13 +149,14 @@ function init(container) {
   $('wp-send').addEventListener('click', async () => {
     try {
       const res = await api('POST', '/api/waypoints/send', { revision: state.mission.revision });
-      say(`Mission of ${res.sent} waypoints sent on ${res.topic}`);
+      say(ngettext('Mission of %(num)d waypoint sent on %(topic)s', 'Mission of %(num)d waypoints sent on %(topic)s', res.sent,
+        { topic: res.topic }));
     } catch (err) { say(err.message, 'error'); }
   });
   $('wp-clear').addEventListener('click', async () => {
     const n = state.mission.waypoints.length;
-    if (!n || !window.confirm(`Delete all ${n} waypoints?`)) return;
-    try { await api('DELETE', '/api/waypoints'); say('All waypoints deleted'); } catch (err) { say(err.message, 'error'); }
+    if (!n || !window.confirm(ngettext('Delete the %(num)d waypoint?', 'Delete all %(num)d waypoints?', n))) return;
+    try { await api('DELETE', '/api/waypoints'); say(_('All waypoints deleted')); } catch (err) { say(err.message, 'error'); }
     await refresh();
   });
   $('wp-import').addEventListener('change', async (ev) => {
@@ -163,7 +165,8 @@ function init(container) {
     if (!file) return;
     try {
       const res = await api('POST', '/api/waypoints/geojson', await file.text());
-      say(`Imported ${res.count} waypoints from ${file.name}`);
+      say(ngettext('Imported %(num)d waypoint from %(file)s', 'Imported %(num)d waypoints from %(file)s', res.count,
+        { file: file.name }));
     } catch (err) { say(`${file.name}: ${err.message}`, 'error'); }
     await refresh();
   });
@@ -173,7 +176,7 @@ function init(container) {
   function noMap(err) {
     const note = $('wp-map-note');
     note.hidden = false;
-    note.textContent = `The map cannot be shown in this browser (${err.message}); the list still works.`;
+    note.textContent = _('The map cannot be shown in this browser (%(reason)s); the list still works.', { reason: err.message });
     map = null;
   }
 

@@ -7,6 +7,7 @@
 import { api, ApiError } from '../../core/api.js';
 import { LayoutModel } from './model.js';
 import { fill, read } from './settings_form.js';
+import { _ } from '../../core/i18n.js';
 
 const PHONE = window.matchMedia('(max-width: 900px)');
 const CELL_PX = 56;
@@ -60,8 +61,8 @@ function tileBody(card) {
   const about = Object.assign(document.createElement('span'), { className: 'muted small', textContent: summary(card) || (t ? t.help : '') });
   const actions = document.createElement('span');
   actions.className = 'editor-tile-actions';
-  actions.append(button('Settings', `settings of this ${card.type} card`, () => openSettings(card.k)),
-    button('Remove', `remove this ${card.type} card`, () => { model.remove(card.k); render(); }));
+  actions.append(button(_('Settings'), _('settings of this %(type)s card', { type: card.type }), () => openSettings(card.k)),
+    button(_('Remove'), _('remove this %(type)s card', { type: card.type }), () => { model.remove(card.k); render(); }));
   body.append(title, about, actions);
   return body;
 }
@@ -89,8 +90,8 @@ function renderList() {
     const li = document.createElement('li');
     li.dataset.k = String(card.k);
     li.append(tileBody(card));
-    const up = button('Up', 'one place up', () => { model.shift(card.k, -1); render(); });
-    const down = button('Down', 'one place down', () => { model.shift(card.k, 1); render(); });
+    const up = button(_('Up'), _('one place up'), () => { model.shift(card.k, -1); render(); });
+    const down = button(_('Down'), _('one place down'), () => { model.shift(card.k, 1); render(); });
     up.disabled = i === 0;
     down.disabled = i === model.cards.length - 1;
     li.querySelector('.editor-tile-actions').prepend(up, down);
@@ -127,7 +128,7 @@ async function start() {
       grid = window.GridStack.init({ column: 12, cellHeight: CELL_PX, margin: 4, float: true, animate: false,
         resizable: { handles: 'se' } }, $('editor-grid'));
       grid.on('change', gridChanged);
-    } catch (err) { say(`${err.message}: the list editor is shown instead`, true); }
+    } catch (err) { say(_('%(reason)s: the list editor is shown instead', { reason: err.message }), true); }
   }
   document.body.dataset.editing = 'yes';
   editor.hidden = false;
@@ -140,7 +141,7 @@ function openSettings(k) {
   const card = model.byKey(k);
   const t = typeOf.get(card.type);
   settingsFor = k;
-  $('editor-settings-title').textContent = `${t.title}: settings`;
+  $('editor-settings-title').textContent = _('%(card)s: settings', { card: t.title });
   fill($('editor-settings-fields'), t, card.settings);
   $('editor-settings').showModal();
 }
@@ -158,10 +159,10 @@ $('editor-settings').addEventListener('close', () => {
 async function saved(call) {
   try {
     await call();
-    say('saved');
+    say(_('saved'));
     location.reload();
   } catch (err) {
-    say(err instanceof ApiError ? err.message : 'the server was not reached; nothing was saved', true);
+    say(err instanceof ApiError ? err.message : _('the server was not reached; nothing was saved'), true);
   }
 }
 
@@ -170,7 +171,9 @@ $('editor-add').addEventListener('change', (e) => {
   const type = e.target.value;
   e.target.value = '';
   if (!type) return;
-  if (!model.add(type)) say(`this layout has a ${typeOf.get(type).title} card already: one is the most`, true);
+  if (!model.add(type)) {
+    say(_('this layout has a %(card)s card already: one is the most', { card: typeOf.get(type).title }), true);
+  }
   else say('');
   render();
 });
@@ -193,11 +196,11 @@ $('editor-import').addEventListener('change', async (e) => {
   });
 });
 $('editor-delete').addEventListener('click', () => {
-  if (layoutId === null || !window.confirm(`Delete the layout "${layout.name}" from this robot, for every user?`)) return;
+  if (layoutId === null || !window.confirm(_('Delete the layout "%(name)s" from this robot, for every user?', { name: layout.name }))) return;
   saved(() => api('DELETE', `/api/layouts/${layoutId}`));
 });
 $('editor-done').addEventListener('click', () => {
-  if (model.history.length && !window.confirm('Close the editor without saving your changes?')) return;
+  if (model.history.length && !window.confirm(_('Close the editor without saving your changes?'))) return;
   location.reload();
 });
 PHONE.addEventListener('change', () => { if (model) render(); });

@@ -2,11 +2,13 @@
 // a choice for an enum, a number for an integer, text for a string, and for a plot's series one
 // "topic field" per line. The server checks what comes back; this only makes it easy to write.
 
+import { _ } from '../../core/i18n.js';
+
 function input(name, schema, value) {
   let el;
   if (schema.enum) {
     el = document.createElement('select');
-    el.append(new Option('(default)', ''));
+    el.append(new Option(_('(default)'), ''));
     for (const v of schema.enum) el.append(new Option(String(v), String(v)));
     el.value = value === undefined ? '' : String(value);
   } else if (schema.type === 'integer') {
@@ -33,13 +35,13 @@ export function fill(container, type, settings) {
   const props = type.settings.properties || {};
   container.replaceChildren();
   if (!Object.keys(props).length) {
-    container.append(Object.assign(document.createElement('p'), { className: 'muted', textContent: 'This card has no settings.' }));
+    container.append(Object.assign(document.createElement('p'), { className: 'muted', textContent: _('This card has no settings.') }));
     return;
   }
   for (const [name, schema] of Object.entries(props)) {
     const label = document.createElement('label');
     label.className = 'editor-setting';
-    const words = schema.type === 'array' ? `${name} (one "topic field" per line)` : name;
+    const words = schema.type === 'array' ? _('%(name)s (one "topic field" per line)', { name }) : name;
     label.append(words, input(name, schema, settings[name]));
     if (schema.description) label.title = schema.description;
     container.append(label);

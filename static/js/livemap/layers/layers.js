@@ -6,6 +6,7 @@ import { api } from '../../core/api.js';
 import { on } from '../../live/live.js';
 import { drawCostmap, renderCostmap } from './costmap.js';
 import { drawFootprint, drawMarker, drawPath, drawScan } from './shapes.js';
+import { _, ngettext, formatNumber } from '../../core/i18n.js';
 
 const STORAGE_KEY = 'rover_web.livemap.layers';
 const OPACITY_KEY = 'rover_web.livemap.costmap_opacity';
@@ -13,7 +14,9 @@ const COUNTS_EVERY_MS = 2000;
 const TRAIL_MAX_POINTS = 2000;
 const TRAIL_STEP_M = 0.05;
 // What placed a layer's latest message on the map (the server's `placed_by`).
-const PLACED_LABELS = { tf: 'placed by TF', configured: 'placed by configured offsets', map: 'in the map frame', amcl: 'placed by AMCL' };
+const PLACED_LABELS = {
+  tf: _('placed by TF'), configured: _('placed by configured offsets'), map: _('in the map frame'), amcl: _('placed by AMCL'),
+};
 
 function showPlaced(el, how) {
   if (!el || !how || el.dataset.placed === how) return;
@@ -86,7 +89,7 @@ export function createLayers(panel, redraw) {
     const robot = document.getElementById('livemap-robot-placed');
     if (robot && p.placed_by && robot.dataset.placed !== p.placed_by) {
       robot.dataset.placed = p.placed_by;
-      robot.textContent = `Robot: ${PLACED_LABELS[p.placed_by] || p.placed_by}`;
+      robot.textContent = _('Robot: %(placed)s', { placed: PLACED_LABELS[p.placed_by] || p.placed_by });
     }
     if (p.stale) return;
     const last = L.trail[L.trail.length - 1];
@@ -103,10 +106,14 @@ export function createLayers(panel, redraw) {
       if (first) L.trail = summary.trail.concat(L.trail);
       for (const [name, c] of Object.entries(summary.layers)) {
         const el = document.getElementById(`overlay-skipped-${name}`);
-        if (el) el.textContent = c.skipped ? `${c.skipped} skipped` : '';
-        const reasons = Object.entries(c.skipped_by_reason).map(([k, v]) => `${k}: ${v}`);
-        if (c.dropped_items) reasons.push(`${c.dropped_items} ${name === 'scan' ? 'beams without a return' : 'items left out'}`);
-        if (el) el.title = `${c.received} received, ${c.converted} drawn${reasons.length ? `; ${reasons.join(', ')}` : ''}`;
+        if (el) el.textContent = c.skipped ? _('%(num)d skipped', { num: c.skipped }) : '';
+        const reasons = Object.entries(c.skipped_by_reason).map(([k, v]) => `${k}: ${formatNumber(v)}`);
+        if (c.dropped_items) {
+          reasons.push(name === 'scan' ? ngettext('%(num)d beam without a return', '%(num)d beams without a return', c.dropped_items)
+            : ngettext('%(num)d item left out', '%(num)d items left out', c.dropped_items));
+        }
+        const counted = _('%(received)d received, %(drawn)d drawn', { received: c.received, drawn: c.converted });
+        if (el) el.title = reasons.length ? `${counted}; ${reasons.join(', ')}` : counted;
         showPlaced(placedEl(name), c.placed_by);
       }
       L.counts = summary.layers;

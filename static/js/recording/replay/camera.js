@@ -2,6 +2,7 @@
 // server (GET .../frame?topic=&t=; 204 before the topic's first frame), shown as an image.
 import { at, errorFrom } from '../../core/api.js';
 import { newestOnly } from './at.js';
+import { _, formatTime, formatUnit } from '../../core/i18n.js';
 
 const IMAGE_TYPES = new Set(['sensor_msgs/msg/Image', 'sensor_msgs/msg/CompressedImage']);
 const MIN_GAP_MS = 80;
@@ -10,7 +11,7 @@ const MIN_GAP_MS = 80;
 export function createCamera(recordingId, data, settings, els) {
   const topics = Object.entries(data.topics).filter(([, info]) => IMAGE_TYPES.has(info.type)).map(([t]) => t);
   if (!topics.length) {
-    els.note.textContent = 'No camera in this recording (it was recorded without the camera).';
+    els.note.textContent = _('No camera in this recording (it was recorded without the camera).');
     els.img.hidden = true;
     els.select.hidden = true;
     return { show() {} };
@@ -36,13 +37,14 @@ export function createCamera(recordingId, data, settings, els) {
     if (shown) els.img.src = shown;
     els.img.dataset.frameTime = answer.logged === null ? '' : answer.logged.toFixed(3);
     els.img.dataset.t = String(answer.t);
-    els.note.textContent = answer.logged === null ? 'No frame yet at this time.'
-      : `Frame of ${new Date(answer.logged * 1000).toLocaleTimeString()} `
-        + `(${(answer.t - answer.logged).toFixed(1)} s before the slider)${answer.error ? `: ${answer.error}` : ''}`;
+    els.note.textContent = answer.logged === null ? _('No frame yet at this time.')
+      : _('Frame of %(time)s (%(before)s before the slider)',
+        { time: formatTime(answer.logged * 1000), before: formatUnit(answer.t - answer.logged, 's', 1) })
+        + (answer.error ? `: ${answer.error}` : '');
   }
 
   const ask = newestOnly(frame, showFrame,
-    (err) => { els.note.textContent = `The frame could not be read: ${err.message}`; }, { minGapMs: MIN_GAP_MS });
+    (err) => { els.note.textContent = _('The frame could not be read: %(reason)s', { reason: err.message }); }, { minGapMs: MIN_GAP_MS });
   const show = (t) => { lastT = t; ask(JSON.stringify([els.select.value, t])); };
   els.select.addEventListener('change', () => show(lastT));
   return { show };

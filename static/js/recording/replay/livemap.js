@@ -7,8 +7,9 @@ import { geometryOf } from '../../livemap/geometry.js';
 import { createViewport } from '../../livemap/view.js';
 import { drawScene, scaleBar } from '../../livemap/draw.js';
 import { attachInput } from '../../livemap/input.js';
-import { degrees, fmt } from '../../livemap/readout.js';
+import { degrees, metres } from '../../livemap/readout.js';
 import { lastAtOrBefore } from './at.js';
+import { _ } from '../../core/i18n.js';
 
 const POSE_KINDS = ['pose', 'odom'];
 
@@ -30,8 +31,8 @@ export function createLiveMap(data, settings, els) {
   const maps = settings.maps || [];
   if (!maps.length || !sources.length) {
     els.message.textContent = !maps.length
-      ? 'No floorplan to draw on: ROVER_WEB_MAPS_FILE lists none.'
-      : `No pose in this recording (${settings.pose_topic} was not recorded, nor any odometry).`;
+      ? _('No floorplan to draw on: ROVER_WEB_MAPS_FILE lists none.')
+      : _('No pose in this recording (%(topic)s was not recorded, nor any odometry).', { topic: settings.pose_topic });
     els.stage.hidden = true;
     return { show() {} };
   }
@@ -96,7 +97,7 @@ export function createLiveMap(data, settings, els) {
       resize();  // measures the stage and fits the new map in it
       els.message.textContent = '';
     } catch (err) {
-      els.message.textContent = `The floorplan ${summary.label} could not be read: ${err.message}`;
+      els.message.textContent = _('The floorplan %(map)s could not be read: %(reason)s', { map: summary.label, reason: err.message });
     }
   }
 
@@ -110,13 +111,13 @@ export function createLiveMap(data, settings, els) {
     const plan = lastAtOrBefore(plans, t);
     S.plan = plan ? { points: plan.points, length: plan.length, frame_id: plan.frame_id } : null;
     els.robot.textContent = S.pose
-      ? `${fmt(S.pose.x)}, ${fmt(S.pose.y)} m · ${degrees(S.pose.yaw)}${S.pose.stale ? ' (stale)' : ''}` : '—';
-    els.goal.textContent = S.goal ? `${fmt(S.goal.x)}, ${fmt(S.goal.y)} m · ${degrees(S.goal.yaw)}` : '—';
+      ? `${metres(S.pose.x, S.pose.y)} · ${degrees(S.pose.yaw)}${S.pose.stale ? ` ${_('(stale)')}` : ''}` : '—';
+    els.goal.textContent = S.goal ? `${metres(S.goal.x, S.goal.y)} · ${degrees(S.goal.yaw)}` : '—';
     redraw();
   }
 
   els.poseSelect.replaceChildren(...sources.map((s, i) => Object.assign(document.createElement('option'), {
-    value: String(i), textContent: `${s.topic}${s.kind === 'odom' ? ' (odometry: its frame drawn as the map’s)' : ''}`,
+    value: String(i), textContent: s.kind === 'odom' ? _('%(topic)s (odometry: its frame drawn as the map’s)', { topic: s.topic }) : s.topic,
   })));
   els.poseSelect.addEventListener('change', () => { S.source = sources[Number(els.poseSelect.value)]; show(S.t); });
   els.select.replaceChildren(...maps.map((m) => Object.assign(document.createElement('option'), {

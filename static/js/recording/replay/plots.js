@@ -5,6 +5,7 @@
 import { api, ApiError } from '../../core/api.js';
 import { chartWidth, joined, makeChart, seriesItems } from '../../plot/chart.js';
 import { lastIndexAtOrBefore } from './at.js';
+import { _, formatNumber } from '../../core/i18n.js';
 
 const HEIGHT = 280;
 const NOT_PLOTTED = new Set(['sensor_msgs/msg/Image', 'sensor_msgs/msg/CompressedImage', 'sensor_msgs/msg/PointCloud2',
@@ -18,7 +19,7 @@ export function createPlots(recordingId, data, els) {
 
   const say = (err) => {
     els.error.hidden = !err;
-    els.error.textContent = err ? (err instanceof ApiError ? err.message : 'the server was not reached') : '';
+    els.error.textContent = err ? (err instanceof ApiError ? err.message : _('the server was not reached')) : '';
   };
   const url = (what, params) => `/api/recordings/${recordingId}/${what}?${params}`;
 
@@ -42,7 +43,7 @@ export function createPlots(recordingId, data, els) {
       const value = i < 0 ? null : s.v[i];
       const li = document.createElement('li');
       li.dataset.series = id;
-      li.textContent = `${id} = ${value === null ? '—' : Number(value.toPrecision(6))}`;
+      li.textContent = `${id} = ${value === null ? '—' : formatNumber(Number(value.toPrecision(6)), { maximumSignificantDigits: 6 })}`;
       return li;
     }));
   }
@@ -73,7 +74,7 @@ export function createPlots(recordingId, data, els) {
   els.form.addEventListener('submit', async (event) => {
     event.preventDefault();
     const field = els.field.value.trim();
-    if (!els.topic.value || !field) { say(new ApiError(400, 'missing', 'choose a topic and a field')); return; }
+    if (!els.topic.value || !field) { say(new ApiError(400, 'missing', _('choose a topic and a field'))); return; }
     try { await add(els.topic.value, field); say(null); } catch (err) { say(err); }
   });
   window.addEventListener('resize', () => { if (chart) chart.setSize({ width: chartWidth(els.chart), height: HEIGHT }); });

@@ -3,15 +3,16 @@
 // part drawn darker and the robot's place at the slider's time as a dot.
 import { createGpsMap } from '../../gps/gps_map.js';
 import { lastIndexAtOrBefore } from './at.js';
+import { _ } from '../../core/i18n.js';
 
 function chooseTrack(series) {
   const fix = Object.entries(series.fix || {}).find(([, points]) => points.length);
-  if (fix) return { name: `${fix[0]} (GPS)`, gps: true, points: fix[1].map((p) => ({ t: p.t, a: p.lng, b: p.lat })) };
+  if (fix) return { name: _('%(topic)s (GPS)', { topic: fix[0] }), gps: true, points: fix[1].map((p) => ({ t: p.t, a: p.lng, b: p.lat })) };
   const odom = Object.entries(series.odom || {}).find(([, points]) => points.length);
   if (odom) {
-    return { name: `${odom[0]} (odometry)`, gps: false, points: odom[1].map((p) => ({ t: p.t, a: p.x, b: p.y })) };
+    return { name: _('%(topic)s (odometry)', { topic: odom[0] }), gps: false, points: odom[1].map((p) => ({ t: p.t, a: p.x, b: p.y })) };
   }
-  return { name: 'no GPS or odometry in this recording', gps: false, points: [] };
+  return { name: _('no GPS or odometry in this recording'), gps: false, points: [] };
 }
 
 function bounds(points) {
@@ -116,7 +117,8 @@ export function createTrack(data, els) {
   function show(t) {
     lastT = t;
     const here = gps ? drawOnMap(t) : drawOnCanvas(t);
-    els.position.textContent = here ? `at ${here.b.toFixed(6)}, ${here.a.toFixed(6)}` : '';
+    // Coordinates keep the dot whatever the language: they are read into other tools as they are.
+    els.position.textContent = here ? _('at %(position)s', { position: `${here.b.toFixed(6)}, ${here.a.toFixed(6)}` }) : '';
   }
 
   if (gps) startMap();
