@@ -83,9 +83,17 @@ def test_an_english_page_names_no_catalogue_and_preloads_i18n_js(live_server, pa
     assert page.evaluate("document.documentElement.lang") == "en"
     assert page.evaluate("document.documentElement.hasAttribute('data-catalogue')") is False
     assert not [url for url in requests_made if url.endswith(".json")]
-    # Named up front (rover_web/web/assets.py): every module imports it, so the browser fetches it at once.
-    preloads = page.eval_on_selector_all("link[rel=modulepreload]", "links => links.map((l) => l.href)")
-    assert any("/static/js/core/i18n." in href for href in preloads), preloads
+    # Every module imports it, so it comes with the page's first scripts: in the page's one bundle
+    # (rover_web/web/bundles.py), or named up front when the page is served unbundled.
+    bundles = page.eval_on_selector_all("script[type=module][src*='/js/bundle/']", "s => s.map((x) => x.src)")
+    if bundles:
+        code = requests.get(bundles[0], timeout=10).text
+        source_map = re.search(r"//# sourceMappingURL=(\S+)", code).group(1)
+        sources = requests.get(bundles[0].rsplit("/", 1)[0] + "/" + source_map, timeout=10).json()["sources"]
+        assert any(s.endswith("core/i18n.js") for s in sources), sources
+    else:
+        preloads = page.eval_on_selector_all("link[rel=modulepreload]", "links => links.map((l) => l.href)")
+        assert any("/static/js/core/i18n." in href for href in preloads), preloads
     assert page.locator("#link-server b").inner_text() == "live"
     assert page.watch.console_errors == []
 
