@@ -13,6 +13,7 @@ import { startGamepad } from './teleop_gamepad.js';
 import { setEstopSender } from './teleop_link.js';
 import { teleopChannel } from '../camera/teleop_channel.js';
 import { linkView } from './link_view.js';
+import { onThemeChange, themeColour } from '../core/theme.js';
 
 const card = document.getElementById('teleop-card');
 if (card) start();
@@ -270,7 +271,13 @@ function start() {
 
   const joystick = window.nipplejs.create({
     zone: $('teleop-joystick'), mode: 'static', position: { left: '50%', top: '50%' },
-    color: '#58a6ff', size: 150, restOpacity: 0.7,
+    color: themeColour('--stick', '#58a6ff'), size: 150, restOpacity: 0.7,
+  });
+  // nipplejs paints its knob once: a new theme repaints it.
+  onThemeChange(() => {
+    for (const el of $('teleop-joystick').querySelectorAll('.nipple .back, .nipple .front')) {
+      el.style.background = themeColour('--stick', '#58a6ff');
+    }
   });
   joystick.on('start', () => {
     stickSuppressed = false;
