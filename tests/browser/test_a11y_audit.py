@@ -14,7 +14,7 @@ pytestmark = pytest.mark.browser
 
 AXE_URL = "/static/vendor/axe-core-4.14.1/axe.min.js"
 TAGS = ["wcag2a", "wcag2aa", "wcag21a", "wcag21aa", "wcag22aa"]
-SIZES = {"desktop": (1400, 1000), "phone": (390, 844)}
+SIZES = {"desktop": {"width": 1400, "height": 1000}, "phone": {"width": 390, "height": 844}}
 THEMES = ["dark", "daylight"]
 # Pages reached from no nav link; the nav's own come from the app's bar (below), so a new page is
 # audited the day it is added to the nav.
@@ -27,7 +27,7 @@ SHOWN = {"/": ["#teleop-link[data-state='live']", "#link-plot canvas"], "/status
 RUN_AXE = """async (tags) => {
     const result = await axe.run(document, { runOnly: { type: 'tag', values: tags }, resultTypes: ['violations'] });
     return result.violations.map(v => ({ id: v.id, impact: v.impact,
-        nodes: v.nodes.slice(0, 5).map(n => `${n.target.join(' ')}: ${n.failureSummary.split('\\n').slice(1, 2).join('')}`) }));
+        nodes: v.nodes.slice(0, 5).map(n => `${n.target.join(' ')}: ${n.failureSummary.split('\\n')[1] || ''}`) }));
 }"""
 
 
@@ -38,8 +38,8 @@ def nav_pages(server_url) -> list[str]:
     return re.findall(r'href="([^"]+)"', nav)
 
 
-def audit(page, path, size):
-    page.set_viewport_size(dict(zip(("width", "height"), SIZES[size])))
+def audit(page, size):
+    page.set_viewport_size(SIZES[size])
     page.wait_for_timeout(150)  # the bar fits itself on the next frame (static/js/header/fit.js)
     return page.evaluate(RUN_AXE, TAGS)
 
@@ -51,7 +51,7 @@ def test_every_page_in_both_themes_at_both_sizes_has_no_wcag_violation(live_serv
     found = {}
     audited = 0
     for theme in THEMES:
-        context = browser.new_context(viewport=dict(zip(("width", "height"), SIZES["desktop"])))
+        context = browser.new_context(viewport=SIZES["desktop"])
         context.add_cookies([{"name": "rover_web_theme", "value": theme, "url": live_server.url}])
         try:
             page = context.new_page()
@@ -68,11 +68,11 @@ def test_every_page_in_both_themes_at_both_sizes_has_no_wcag_violation(live_serv
                 assert page.evaluate("typeof window.axe") == "undefined"  # no page loads it itself
                 page.add_script_tag(url=live_server.url + AXE_URL)
                 for size in SIZES:
-                    violations = audit(page, path, size)
+                    violations = audit(page, size)
                     audited += 1
                     if violations:
                         found[f"{path} {theme} {size}"] = violations
-                page.set_viewport_size(dict(zip(("width", "height"), SIZES["desktop"])))
+                page.set_viewport_size(SIZES["desktop"])
         finally:
             context.close()
     assert found == {}, json.dumps(found, indent=1)
