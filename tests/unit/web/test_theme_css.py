@@ -39,5 +39,6 @@ def test_the_dark_themes_state_colours_are_only_in_the_variables():
         # (A map legend swatch or marker keeps the colour its map layer is drawn in; text on a
         # ground of its own that is the same in both themes says "either theme".)
         for colour in ("#7ee787", "#e3b341", "#ff7b72"):
-            lines = [line for line in text.splitlines() if colour in line and not re.search(r"swatch|vertex|either theme", line)]
+            lines = [line for line in text.splitlines()
+                     if colour in line and not re.search(r"swatch|vertex|either theme", line)]
             assert lines == [], (sheet.name, colour, lines)
