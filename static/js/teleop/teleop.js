@@ -301,7 +301,10 @@ function start() {
     if (e.ctrlKey || e.metaKey || e.altKey) return;
     if (e.code === 'Space') {
       if (typing(e.target) && e.target.type !== 'range') return;
-      e.preventDefault();
+      // Space on a focused button still presses it (E-STOP by keyboard: docs/accessibility.md);
+      // anywhere else it only stops, and does not scroll the page.
+      const control = e.target.closest && e.target.closest('button, summary, a[href], [role="button"]');
+      if (!control) e.preventDefault();
       stopAll();
       return;
     }
