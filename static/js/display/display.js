@@ -30,9 +30,25 @@ function setup() {
     applyTheme(theme.value);
     save('theme', theme.value).catch(() => {});
   });
-  language.addEventListener('change', async () => {
-    try { await save('language', language.value); } catch { /* the cookie is set: reload all the same */ }
+  // A new language renders the page again. Picked with the pointer, at once; with the keyboard,
+  // an arrow key changes the value at each press, so the page waits for Enter or for the focus to
+  // leave the list (WCAG 3.2.2: no change of page while the user is still choosing).
+  let pointer = false;
+  let saving = null;
+  language.addEventListener('pointerdown', () => { pointer = true; });
+  language.addEventListener('keydown', (e) => {
+    pointer = false;
+    if (e.key === 'Enter' && saving) reload();
+  });
+  language.addEventListener('blur', () => { if (saving) reload(); });
+  async function reload() {
+    try { await saving; } catch { /* kept in the cookie: render again all the same */ }
     window.location.reload();
+  }
+  language.addEventListener('change', () => {
+    saving = save('language', language.value);
+    if (pointer) reload();
+    else note.textContent = 'Press Enter to show the page in this language.';
   });
 
   // Closes on Escape (focus back on its button) or a click elsewhere, like the page menu.
