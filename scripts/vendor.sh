@@ -24,6 +24,7 @@ SWAGGER_UI_VERSION="5.35.0"
 GRIDSTACK_VERSION="14.1.0"
 THREE_VERSION="0.187.0"
 URDF_LOADER_VERSION="0.13.1"
+AXE_CORE_VERSION="4.14.1"  # tests only (tests/browser/test_a11y_audit.py injects it); no page loads it
 
 # sha256 of the npm tarballs (npm itself also checks the registry's sha512
 # integrity when it downloads them).
@@ -40,6 +41,7 @@ ESBUILD_VERSION="0.28.2"
 ESBUILD_TGZ_SHA256="9573bb2233aab0f9ea7647d5cca9726113cc1768de61d66b17267f4db84488f6"  # @esbuild/linux-x64
 THREE_TGZ_SHA256="ff540832ded0cfe919764d24a3d88f3e2a05f23303f876423e4f893841e90728"
 URDF_LOADER_TGZ_SHA256="19909aad681a1dfb5e4820aaf8369f6ff0837ae91dbb664f47895fe2d64f0b83"
+AXE_CORE_TGZ_SHA256="e6b0ce02b84d892e2e33e403485e7f3d6c29e2be6df65daf44d89ba564139745"
 
 # "<path inside the package>  <name in static/vendor/...>  <sha256>"
 NIPPLEJS_FILES=(
@@ -64,6 +66,10 @@ SWAGGER_UI_FILES=(
 )
 # The dashboard editor's drag and resize (docs/dashboards.md says why gridstack): the UMD bundle with
 # its drag-and-drop, which sets window.GridStack, and its stylesheet.
+AXE_CORE_FILES=(
+  "axe.min.js  axe.min.js  29348999450cdf2849a8e70b7912fc2da85a849da39c0d0d5394f51d4a9ed95c"
+  "LICENSE     LICENSE     af175b9d96ee93c21a036152e1b905b0b95304d4ae8c2c921c7609100ba8df7e"
+)
 GRIDSTACK_FILES=(
   "dist/gridstack-all.js    gridstack-all.js    e12690e8e671d752c8007993967830e6a4b8bcfb2787ac85d1100dff765460b4"
   "dist/gridstack.min.css   gridstack.min.css   74efc82159c5e8d28cb2cebd9f912be9d728bb07fa83896a6b62f4a843207126"
@@ -200,6 +206,7 @@ if [[ "${1:-}" == "--check" ]]; then
   verify_dir "$VENDOR_DIR/gridstack-$GRIDSTACK_VERSION" "${GRIDSTACK_FILES[@]}" || rc=1
   verify_dir "$VENDOR_DIR/three-$THREE_VERSION" "${THREE_FILES[@]}" || rc=1
   verify_dir "$VENDOR_DIR/urdf-loader-$URDF_LOADER_VERSION" "${URDF_LOADER_FILES[@]}" || rc=1
+  verify_dir "$VENDOR_DIR/axe-core-$AXE_CORE_VERSION" "${AXE_CORE_FILES[@]}" || rc=1
   [[ $rc -eq 0 ]] && echo "vendor.sh: all vendored files match their pinned sha256"
   exit "$rc"
 elif [[ $# -gt 0 ]]; then
@@ -218,5 +225,6 @@ vendor_pkg swagger-ui-dist "$SWAGGER_UI_VERSION" "$SWAGGER_UI_TGZ_SHA256" "${SWA
 vendor_pkg gridstack "$GRIDSTACK_VERSION" "$GRIDSTACK_TGZ_SHA256" "${GRIDSTACK_FILES[@]}"
 vendor_pkg three "$THREE_VERSION" "$THREE_TGZ_SHA256" "${THREE_FILES[@]}"
 vendor_pkg urdf-loader "$URDF_LOADER_VERSION" "$URDF_LOADER_TGZ_SHA256" "${URDF_LOADER_FILES[@]}"
+vendor_pkg axe-core "$AXE_CORE_VERSION" "$AXE_CORE_TGZ_SHA256" "${AXE_CORE_FILES[@]}"
 install -m 0644 /usr/share/common-licenses/Apache-2.0 "$VENDOR_DIR/urdf-loader-$URDF_LOADER_VERSION/LICENSE"
 echo "vendor.sh: done"

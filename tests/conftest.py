@@ -401,7 +401,10 @@ def page(browser):
     # bypass_csp: Playwright's wait_for_function compiles its predicate in the page, which the
     # app's Content-Security-Policy forbids (no 'unsafe-eval'). tests/browser/test_csp.py loads
     # every page with the policy on and checks that nothing the app itself does is refused.
-    context = browser.new_context(viewport={"width": 1280, "height": 900}, bypass_csp=True)
+    # color_scheme: the pages' theme is "auto" unless chosen, and follows it; the tests written
+    # before the daylight theme see the dark one they were written for. Daylight is tested on
+    # purpose (tests/browser/test_field_a11y.py, test_a11y_audit.py).
+    context = browser.new_context(viewport={"width": 1280, "height": 900}, bypass_csp=True, color_scheme="dark")
     pg = context.new_page()
     pg.watch = PageWatch(pg)
     yield pg

@@ -249,7 +249,9 @@ def test_zoom_with_buttons_wheel_and_pinch_and_pan_by_dragging(live_server, brow
         page.mouse.wheel(0, -300)
         page.wait_for_function(f"window.liveMapState.view.scale > {scale0 * 1.3}")
         s = state(page)
-        assert expected_screen(s, 30.0, 5.0) == pytest.approx((x, y), abs=0.5)
+        # Within a pixel: the pointer lands on a whole pixel, and where the canvas starts need not
+        # (the touch layout's 44 px controls above it, docs/accessibility.md).
+        assert expected_screen(s, 30.0, 5.0) == pytest.approx((x, y), abs=1.0)
         # Drag pans by exactly the drag.
         before = state(page)["view"]
         page.mouse.move(left + 400, top + 300)

@@ -8,4 +8,9 @@ window.SwaggerUIBundle({
   deepLinking: true,
   tryItOutEnabled: false, // calls that move the robot should be deliberate, not one click away
   docExpansion: "none", // 26 sections, 127 operations: each opens on a click (all at once did not render)
+  // Swagger UI's server list has a visible "Servers" title but no label a screen reader links to it.
+  onComplete: () => {
+    const servers = document.getElementById("servers");
+    if (servers && !servers.hasAttribute("aria-label")) servers.setAttribute("aria-label", "Servers");
+  },
 });

@@ -6,8 +6,8 @@ import { api, ApiError } from '../core/api.js';
 import { on } from '../live/live.js';
 import { loadUplot } from '../core/vendor.js';
 import { _ } from '../core/i18n.js';
+import { onThemeChange, plotAxes, seriesColour } from '../core/theme.js';
 
-const COLOURS = ['#58a6ff', '#e3b341', '#7ee787', '#ff7b72'];
 const KEEP_ALIVE_MS = 10000;
 const HEIGHT = 200;
 
@@ -50,8 +50,8 @@ function draw(card) {
     if (!shown.length) return;
     card.chart = new window.uPlot({
       width, height: HEIGHT, legend: { live: false },
-      series: [{}, ...shown.map((s, i) => ({ label: s.field, stroke: COLOURS[i % COLOURS.length], spanGaps: true }))],
-      axes: [{ stroke: '#8b949e' }, { stroke: '#8b949e', size: 50 }],
+      series: [{}, ...shown.map((s, i) => ({ label: s.field, stroke: () => seriesColour(i), spanGaps: true }))],
+      axes: plotAxes(50),
     }, data(card), card.chartEl);
   } else {
     card.chart.setData(data(card));
@@ -92,6 +92,7 @@ if (cards.length) {
   setInterval(() => {
     for (const card of cards) for (const s of card.series) api('GET', `/api/plot?${query(s, 1)}`).catch(() => {});
   }, KEEP_ALIVE_MS);
+  onThemeChange(() => { for (const card of cards) if (card.chart) card.chart.redraw(false, true); });
   window.addEventListener('resize', () => {
     for (const card of cards) if (card.chart) card.chart.setSize({ width: Math.max(200, card.chartEl.clientWidth), height: HEIGHT });
   });

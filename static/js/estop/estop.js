@@ -93,6 +93,8 @@ async function release() {
 
 if (box) {
   engageButton.addEventListener('click', engage);
+  // The Drive card's own E-STOP under the thumb (partials/teleop.html), the same engage.
+  for (const other of document.querySelectorAll('[data-estop-engage]')) other.addEventListener('click', engage);
   // The e-stop is a form so that it works before this module runs (partials/estop.html); from now
   // on the click above engages, over the open socket first, and the form is not sent too.
   box.addEventListener('submit', (event) => event.preventDefault());

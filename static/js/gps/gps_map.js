@@ -2,6 +2,7 @@
 // nothing is fetched but from this app: raster tiles of a local store and drawn GeoJSON basemaps
 // (rover_web/basemap), a graticule to read positions by, and the same controls everywhere.
 // maplibregl is the vendored global (static/vendor/maplibre-gl-*), loaded with `defer`.
+import { effectiveTheme, onThemeChange, themeColour } from '../core/theme.js';
 
 // Coordinates keep the decimal point and N/S/E/W whatever the page's language (ISO 6709's letters):
 // operators read them into other tools as they are.
@@ -19,9 +20,17 @@ export const FEATURE_COLORS = {
   land: '#2b3a2e', park: '#2f4a33', wetland: '#2e4a45', sand: '#5a5238', water: '#1d4f7a',
   pier: '#6e6a60', building: '#4a4f57', road: '#8a8f98', path: '#b7a98a', shore: '#5f9fd6',
 };
+// Daylight: a pale ground under dark lines, so the robot's and the plan's strong colours stand out
+// in the sun as they do on the dark map.
+const DAYLIGHT_COLORS = {
+  land: '#e6ede1', park: '#cfe3c4', wetland: '#cde2dc', sand: '#eee2bb', water: '#9cc7ea',
+  pier: '#b5ae9f', building: '#c4c8cf', road: '#5d636c', path: '#85704a', shore: '#1f5f9e',
+};
+const palette = () => (effectiveTheme() === 'daylight' ? DAYLIGHT_COLORS : FEATURE_COLORS);
+const gridColour = (underlay) => (underlay ? '#00000033' : themeColour('--plot-axis', '#5b6b7b'));
 const AREA_KINDS = ['land', 'park', 'wetland', 'sand', 'water', 'pier', 'building'];
 const LINE_KINDS = ['shore', 'path', 'road'];
-const colorOf = (kinds) => ['match', ['get', 'kind'], ...kinds.flatMap((k) => [k, FEATURE_COLORS[k]]), '#888888'];
+const colorOf = (kinds) => ['match', ['get', 'kind'], ...kinds.flatMap((k) => [k, palette()[k]]), '#888888'];
 
 function featureLayers(source) {
   const area = ['in', ['geometry-type'], ['literal', ['Polygon', 'MultiPolygon']]];
@@ -32,7 +41,7 @@ function featureLayers(source) {
       filter: ['all', area, ['in', ['get', 'kind'], ['literal', AREA_KINDS.filter((k) => k !== 'water')]]],
       paint: { 'fill-color': colorOf(AREA_KINDS) } },
     { id: `${source}-water`, type: 'fill', source, filter: ['all', area, ['==', ['get', 'kind'], 'water']],
-      paint: { 'fill-color': FEATURE_COLORS.water } },
+      paint: { 'fill-color': palette().water } },
     { id: `${source}-lines`, type: 'line', source,
       filter: ['all', line, ['in', ['get', 'kind'], ['literal', LINE_KINDS]]],
       layout: { 'line-cap': 'round', 'line-join': 'round' },
@@ -46,7 +55,7 @@ function buildStyle(cfg, sources, layers) {
   const style = {
     version: 8,
     sources: { graticule: { type: 'geojson', data: EMPTY }, ...sources },
-    layers: [{ id: 'background', type: 'background', paint: { 'background-color': '#17212b' } }],
+    layers: [{ id: 'background', type: 'background', paint: { 'background-color': themeColour('--map-bg', '#17212b') } }],
   };
   // Drawn basemaps under the raster tiles: where a store has tiles (imagery, a real survey) they
   // win; beyond the store's bounds the drawn ones still show.
@@ -63,7 +72,7 @@ function buildStyle(cfg, sources, layers) {
   const underlay = cfg.basemap || drawn.length;
   style.layers.push(
     { id: 'graticule', type: 'line', source: 'graticule',
-      paint: { 'line-color': underlay ? '#00000033' : '#5b6b7b', 'line-width': 1 } },
+      paint: { 'line-color': gridColour(underlay), 'line-width': 1 } },
     ...layers,
   );
   return style;
@@ -111,5 +120,17 @@ export function createGpsMap(container, cfg, { sources = {}, layers = [], onLoad
     container.dataset.ready = 'yes';
   });
   map.on('moveend', () => { if (loaded) updateGrid(); });
+  // A theme change repaints the ground, the drawn basemaps and the grid; the page's own layers keep
+  // their colours (strong in both themes).
+  onThemeChange(() => {
+    if (!loaded) return;
+    map.setPaintProperty('background', 'background-color', themeColour('--map-bg', '#17212b'));
+    (cfg.features || []).forEach((_, i) => {
+      map.setPaintProperty(`features-${i}-land`, 'fill-color', colorOf(AREA_KINDS));
+      map.setPaintProperty(`features-${i}-water`, 'fill-color', palette().water);
+      map.setPaintProperty(`features-${i}-lines`, 'line-color', colorOf(LINE_KINDS));
+    });
+    map.setPaintProperty('graticule', 'line-color', gridColour(cfg.basemap || (cfg.features || []).length));
+  });
   return map;
 }

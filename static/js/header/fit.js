@@ -1,6 +1,7 @@
 // The bar on top of every page stays one line and never hides anything: what does not fit goes
 // into the menu, in this order: the signed-in user, nav links (the last first), then the bar gets
-// tighter (header.css: squeeze-1 ... squeeze-3), and last the robot selector joins the menu. The
+// tighter (header.css: squeeze-1 ... squeeze-3), then the Display menu and last the robot selector
+// join the menu. The
 // e-stop and "Stop all" never leave the bar. It fits again whenever the window or anything in the
 // bar changes size (a pill's word, the e-stop's state, a longer robot name).
 import { _ } from '../core/i18n.js';
@@ -20,16 +21,20 @@ function setup() {
   const links = [...nav.querySelectorAll('a')];
   const user = bar.querySelector(':scope > .whoami');
   const robot = bar.querySelector(':scope > .robot-select');
+  const display = bar.querySelector(':scope > .display-menu');
   const userAnchor = document.createComment('user');
   const robotAnchor = document.createComment('robot');
+  const displayAnchor = document.createComment('display');
   if (user) user.before(userAnchor);
   if (robot) robot.before(robotAnchor);
+  if (display) display.before(displayAnchor);
 
   // The steps, in the order they are taken; apply(k) takes the first k, from a clean bar.
   const steps = [
     ...(user ? [{ kind: 'user' }] : []),
     ...links.map((_, i) => ({ kind: 'link', index: links.length - 1 - i })),
     ...Array.from({ length: SQUEEZES }, (_, i) => ({ kind: 'squeeze', level: i + 1 })),
+    ...(display ? [{ kind: 'display' }] : []),
     ...(robot ? [{ kind: 'robot' }] : []),
   ];
 
@@ -44,11 +49,13 @@ function setup() {
     nav.hidden = moved.size === links.length;
     const userOut = taken.some((s) => s.kind === 'user');
     const robotOut = taken.some((s) => s.kind === 'robot');
+    const displayOut = taken.some((s) => s.kind === 'display');
     if (user) (userOut ? menuMore.append(user) : userAnchor.after(user));
+    if (display) (displayOut ? menuMore.append(display) : displayAnchor.after(display));
     if (robot) (robotOut ? menuMore.prepend(robot) : robotAnchor.after(robot));
     const squeeze = taken.filter((s) => s.kind === 'squeeze').length;
     for (let level = 1; level <= SQUEEZES; level += 1) bar.classList.toggle(`squeeze-${level}`, level <= squeeze);
-    const any = moved.size > 0 || userOut || robotOut;
+    const any = moved.size > 0 || userOut || robotOut || displayOut;
     menu.hidden = !any;
     if (!any) menu.open = false;
     // "More" while some pages are still in the bar, "Menu" once they all are in it.

@@ -6,6 +6,7 @@ import { at } from '../core/api.js';
 import { on } from '../live/live.js';
 import { loadUplot } from '../core/vendor.js';
 import { _ } from '../core/i18n.js';
+import { onThemeChange, plotAxes, seriesColour } from '../core/theme.js';
 
 const KEEP = 300;
 const el = document.getElementById('link-plot');
@@ -21,15 +22,17 @@ function draw() {
     chart = new window.uPlot({
       width: Math.max(240, el.clientWidth), height: 160,
       scales: { ms: { distr: 3 } },
-      series: [{}, { label: _('round trip ms'), scale: 'ms', stroke: '#58a6ff', spanGaps: false },
-        { label: _('robot msg age ms'), scale: 'ms', stroke: '#e3b341', spanGaps: false }],
-      axes: [{ stroke: '#8b949e' }, { scale: 'ms', stroke: '#8b949e', size: 50 }],
+      series: [{}, { label: _('round trip ms'), scale: 'ms', stroke: () => seriesColour(0), spanGaps: false },
+        { label: _('robot msg age ms'), scale: 'ms', stroke: () => seriesColour(1), spanGaps: false }],
+      axes: plotAxes(50).map((axis, i) => (i === 1 ? { ...axis, scale: 'ms' } : axis)),
       legend: { live: false },
     }, [t, rtt, age], el);
   } else {
     chart.setData([t, rtt, age]);
   }
 }
+
+onThemeChange(() => { if (chart) chart.redraw(false, true); });
 
 function push(rttMs, ageMs) {
   t.push(Date.now() / 1000);

@@ -2,10 +2,14 @@
 // landed on screen (published for tests and the curious); it keeps no state between frames.
 import { insideMap, isDrag, screenAngle, screenOfMapYaw, worldToScreen } from './geometry.js';
 import { formatUnit } from '../core/i18n.js';
+import { themeColour } from '../core/theme.js';
 
 export const COLORS = { robot: '#1f6feb', robotStale: '#6e7681', heading: '#ffffff', goal: '#f0883e',
-  plan: '#3fb950', waypoint: '#d2a8ff', preview: '#f0883e', background: '#0b0f13', keepOut: '#f85149',
-  posePreview: '#56d4dd' };
+  plan: '#3fb950', preview: '#f0883e', keepOut: '#f85149', posePreview: '#56d4dd',
+  // Names are text: light violet on the dark canvas, dark violet on the daylight one.
+  get waypoint() { return themeColour('--plot-5', '#d2a8ff'); },
+  // Around the map (and the shadow under names): the theme's, so the canvas is light in daylight.
+  get background() { return themeColour('--canvas-bg', '#0b0f13'); } };
 // The robot at its real size, but never smaller than a dot one can find.
 const MIN_ROBOT_PX = 5;
 

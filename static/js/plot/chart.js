@@ -3,9 +3,12 @@
 // chart selects (onSelect), a double click zooms out; `marker` draws a vertical line at a time.
 
 import { _ } from '../core/i18n.js';
+import { onThemeChange, plotAxes, seriesColour, themeColour } from '../core/theme.js';
 
-export const COLOURS = ['#58a6ff', '#e3b341', '#7ee787', '#ff7b72', '#d2a8ff', '#79c0ff', '#ffa657', '#a5d6ff'];
-export const MARKER_COLOUR = '#f85149';
+// Colours are the theme's (static/css/app.css, --plot-*): read at each draw, so a chart follows a
+// theme change (charts made here redraw on it).
+const charts = new Set();
+onThemeChange(() => charts.forEach((u) => u.redraw(false, true)));
 
 export const chartWidth = (el) => Math.max(320, el.clientWidth);
 
@@ -24,7 +27,7 @@ export function makeChart(el, labels, data, { height = 420, onSelect = null, mar
       if (x < u.bbox.left || x > u.bbox.left + u.bbox.width) return;
       const { ctx } = u;
       ctx.save();
-      ctx.strokeStyle = MARKER_COLOUR;
+      ctx.strokeStyle = themeColour('--bad');
       ctx.lineWidth = 2 * (window.devicePixelRatio || 1);
       ctx.beginPath();
       ctx.moveTo(x, u.bbox.top);
@@ -35,11 +38,14 @@ export function makeChart(el, labels, data, { height = 420, onSelect = null, mar
   }
   const opts = {
     width: chartWidth(el), height,
-    series: [{}, ...labels.map((label, i) => ({ label, stroke: COLOURS[i % COLOURS.length], spanGaps: true }))],
-    axes: [{ stroke: '#8b949e' }, { stroke: '#8b949e', size: 60 }],
+    series: [{}, ...labels.map((label, i) => ({ label, stroke: () => seriesColour(i), spanGaps: true }))],
+    axes: plotAxes(60),
     hooks,
   };
-  return new window.uPlot(opts, data, el);
+  hooks.destroy = [(u) => charts.delete(u)];
+  const chart = new window.uPlot(opts, data, el);
+  charts.add(chart);
+  return chart;
 }
 
 // The list of plotted series, each with its × to remove it (the Plot page's and the replay's).

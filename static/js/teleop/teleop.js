@@ -23,6 +23,7 @@ const STOP_REASONS = {
   rest_stop: _('stop request'), estop: _('e-stop'), link_lost: _('link lost'), duration_elapsed: _('duration elapsed'),
   deadman: _('deadman'), bad_input: _('bad input'),
 };
+import { onThemeChange, themeColour } from '../core/theme.js';
 
 const card = document.getElementById('teleop-card');
 if (card) start();
@@ -281,7 +282,13 @@ function start() {
 
   const joystick = window.nipplejs.create({
     zone: $('teleop-joystick'), mode: 'static', position: { left: '50%', top: '50%' },
-    color: '#58a6ff', size: 150, restOpacity: 0.7,
+    color: themeColour('--stick', '#58a6ff'), size: 150, restOpacity: 0.7,
+  });
+  // nipplejs paints its knob once: a new theme repaints it.
+  onThemeChange(() => {
+    for (const el of $('teleop-joystick').querySelectorAll('.nipple .back, .nipple .front')) {
+      el.style.background = themeColour('--stick', '#58a6ff');
+    }
   });
   joystick.on('start', () => {
     stickSuppressed = false;
@@ -305,7 +312,10 @@ function start() {
     if (e.ctrlKey || e.metaKey || e.altKey) return;
     if (e.code === 'Space') {
       if (typing(e.target) && e.target.type !== 'range') return;
-      e.preventDefault();
+      // Space on a focused button still presses it (E-STOP by keyboard: docs/accessibility.md);
+      // anywhere else it only stops, and does not scroll the page.
+      const control = e.target.closest && e.target.closest('button, summary, a[href], [role="button"]');
+      if (!control) e.preventDefault();
       stopAll();
       return;
     }

@@ -5,6 +5,7 @@
 import * as THREE from './three.js';
 import { api, at } from '../core/api.js';
 import { on } from '../live/live.js';
+import { onThemeChange, themeColour } from '../core/theme.js';
 import { CloudLayer } from './cloud.js';
 import { MarkerLayer } from './markers.js';
 import { Overlays } from './overlays.js';
@@ -29,7 +30,10 @@ export class Viewer {
     this.poses = new Poses();
     this.renderer = new THREE.WebGLRenderer({ antialias: false });
     this.renderer.setPixelRatio(1);
-    this.renderer.setClearColor(0x1b1f24);
+    // The theme's ground (--scene-bg): dark, or light for daylight; again on a theme change.
+    const ground = () => this.renderer.setClearColor(new THREE.Color(themeColour('--scene-bg', '#1b1f24')));
+    ground();
+    onThemeChange(() => { ground(); this.requestDraw(); });
     container.appendChild(this.renderer.domElement);
     this.scene = new THREE.Scene();
     this.camera = new THREE.PerspectiveCamera(50, 1, 0.05, 2000);
