@@ -1,0 +1,126 @@
+"""The `message` of an API error: an English msgid and its values, translated where the answer is made.
+
+A refusal is written once, where it is decided, as an English msgid with `%(name)s` placeholders and
+the values that fill them: `ApiError(404, "not_found", "no layout %(id)s on this robot", id=layout_id)`.
+It stays English in logs and in `str(exc)`; only the JSON answer (or a WebSocket frame) renders it in
+the request's language, so a site stays one line and `pybabel extract` finds every msgid by keyword
+(the keywords are in docs/i18n_api.md). Values are never translated (topic names, numbers, codes),
+unless a value is itself a Text (a reason given by another part, e.g. a layout's schema error).
+
+The error `code` is never translated: clients branch on it.
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Any
+
+from flask import current_app, has_request_context
+
+log = logging.getLogger(__name__)
+
+# The staging domain of the API's messages, then the app's one catalogue (the lead folds api.po
+# into messages.po at merge; looking in both keeps either layout working).
+_DOMAIN_NAMES = ("api", "messages")
+
+
+class Text:
+    """An English msgid and the values that fill its placeholders."""
+
+    __slots__ = ("msgid", "values")
+
+    def __init__(self, msgid: str, values: dict[str, Any] | None = None):
+        self.msgid = msgid
+        self.values = values or {}
+
+    def english(self) -> str:
+        return _fill(self.msgid, self.values, Text.english)
+
+    def translated(self) -> str:
+        """In the request's language when a catalogue has it; the English otherwise, never an error."""
+        translated = _lookup(self.msgid)
+        if translated == self.msgid:
+            return _fill(self.msgid, self.values, Text.translated)
+        try:
+            return _fill(translated, self.values, Text.translated)
+        except (KeyError, ValueError, TypeError):
+            # A catalogue whose placeholders do not match the msgid's: the English, and say so.
+            log.warning("the translation of %r does not fit its values; answering in English", self.msgid)
+            return _fill(self.msgid, self.values, Text.translated)
+
+    def __str__(self) -> str:
+        return self.english()
+
+    def __repr__(self) -> str:
+        return f"Text({self.msgid!r}, {self.values!r})"
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, Text):
+            return (self.msgid, self.values) == (other.msgid, other.values)
+        return NotImplemented
+
+    __hash__ = None  # values may be unhashable
+
+
+def explain(msgid: str, **values: Any) -> Text:
+    """A reason written where it is decided and shown elsewhere (an exception's argument).
+
+    `explain` is an extraction keyword: the msgid must be a literal.
+    """
+    return Text(msgid, values)
+
+
+def text_of(exc: BaseException) -> Text:
+    """The Text an exception was raised with (its `text`, or an `explain(...)` argument).
+
+    An exception that carries none (a library's) gives its English, untranslated.
+    """
+    carried = getattr(exc, "text", None)
+    if isinstance(carried, Text):
+        return carried
+    if exc.args and isinstance(exc.args[0], Text):
+        return exc.args[0]
+    return Text("%(reason)s", {"reason": str(exc)})
+
+
+def as_text(message: str | Text, values: dict[str, Any]) -> Text:
+    if isinstance(message, Text):
+        if values:
+            return Text(message.msgid, {**message.values, **values})
+        return message
+    return Text(message, values)
+
+
+def N_(msgid: str) -> str:  # noqa: N802 - gettext's name for "translate later", known to every extractor
+    """Mark a msgid kept in a table and used as an ApiError/error_response message elsewhere."""
+    return msgid
+
+
+def _fill(msgid: str, values: dict[str, Any], render) -> str:
+    if not values:
+        return msgid
+    rendered = {name: render(value) if isinstance(value, Text) else value for name, value in values.items()}
+    return msgid % rendered
+
+
+def _lookup(msgid: str) -> str:
+    if not has_request_context() or "babel" not in current_app.extensions:
+        return msgid  # no Babel set up (a tool, a test app): English
+    try:
+        for name in _DOMAIN_NAMES:
+            translated = _domain(name).gettext(msgid)
+            if translated != msgid:
+                return translated
+    except Exception:  # noqa: BLE001 - an unreadable catalogue or locale must never turn an error into a 500
+        log.warning("no translation of an API message could be looked up; answering in English", exc_info=True)
+    return msgid
+
+
+def _domain(name: str):
+    # One per app: a Domain caches its catalogues, which come from that app's translation directories.
+    domains = current_app.extensions.setdefault("rover_web_api_domains", {})
+    domain = domains.get(name)
+    if domain is None:
+        from flask_babel import Domain  # only where Babel is set up on the app
+        domain = domains[name] = Domain(domain=name)
+    return domain

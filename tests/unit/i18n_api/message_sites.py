@@ -1,0 +1,80 @@
+"""Where an API error's message is written, and whether `pybabel extract` can read it there.
+
+Shared by the catalogue test and scripts: the keywords here are the ones docs/i18n_api.md gives the
+lead for babel.cfg.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[3]
+PACKAGE = ROOT / "rover_web"
+
+# callable name -> index (0-based) of its message argument. Babel's spec is 1-based: NAME:index+1.
+MESSAGE_ARG = {
+    "ApiError": 2,
+    "error_response": 2,
+    "InvalidInput": 0,
+    "explain": 0,
+    "N_": 0,
+}
+KEYWORDS = [f"{name}:{index + 1}" for name, index in MESSAGE_ARG.items()]
+
+# A message that is not a literal may only be a Text carried from where it was written and extracted.
+CARRIERS = {"text_of", "explain", "_http_text"}
+
+
+def _name(func: ast.expr) -> str | None:
+    if isinstance(func, ast.Name):
+        return func.id
+    if isinstance(func, ast.Attribute):
+        return func.attr
+    return None
+
+
+def _carried(arg: ast.expr) -> bool:
+    if isinstance(arg, ast.Attribute) and arg.attr == "text":
+        return True
+    return isinstance(arg, ast.Call) and _name(arg.func) in CARRIERS
+
+
+def problems(root: Path = PACKAGE) -> list[str]:
+    """Every call site whose message pybabel could not extract (an f-string, a variable...)."""
+    found = []
+    for path in sorted(root.rglob("*.py")):
+        tree = ast.parse(path.read_text(), str(path))
+        for node in ast.walk(tree):
+            if not isinstance(node, ast.Call):
+                continue
+            name = _name(node.func)
+            if name not in MESSAGE_ARG:
+                continue
+            index = MESSAGE_ARG[name]
+            where = f"{path.relative_to(ROOT)}:{node.lineno} {name}"
+            if any(isinstance(a, ast.Starred) for a in node.args[:index + 1]) or any(
+                    k.arg is None for k in node.keywords):
+                found.append(f"{where}: *args/**kwargs hide the message")
+                continue
+            if len(node.args) <= index:
+                if name in ("ApiError", "InvalidInput") and any(k.arg == "message" for k in node.keywords):
+                    found.append(f"{where}: message given by keyword; pass it positionally")
+                elif name not in ("ApiError", "error_response", "InvalidInput", "explain"):
+                    continue
+                else:
+                    found.append(f"{where}: no message")
+                continue
+            arg = node.args[index]
+            if isinstance(arg, ast.Constant) and isinstance(arg.value, str):
+                continue
+            if name not in ("explain", "N_") and _carried(arg):
+                continue
+            kind = "an f-string" if isinstance(arg, ast.JoinedStr) else type(arg).__name__
+            found.append(f"{where}: message is {kind}, not a literal msgid")
+    return found
+
+
+if __name__ == "__main__":
+    for line in problems():
+        print(line)
