@@ -10,6 +10,7 @@ from flask import Blueprint, g, jsonify, make_response, redirect, render_templat
 from flask_login import current_user, login_user, logout_user
 
 from rover_web.core.state import current_feature, current_rover
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import ApiError, accepts_form, error_response, json_body, wants_json
 from rover_web.web.validate import InvalidInput, only_keys, text
 
@@ -50,8 +51,9 @@ def check_access():
         return None
     if not current_user.is_authenticated and exposure is not None and auth.accounts.count() == 0:
         return error_response(403, "sign_in_needed",
-                              f"sign-in is off only for requests made on this machine, and {exposure}; "
-                              f"set ROVER_WEB_AUTH=required and add a user with `{ADD_USER_HINT}`")
+                              "sign-in is off only for requests made on this machine, and %(exposure)s; set "
+                              "ROVER_WEB_AUTH=required and add a user with `%(add_user_hint)s`",
+                              exposure=exposure, add_user_hint=ADD_USER_HINT)
     if not current_user.is_authenticated:
         if request.method == "GET" and not wants_json(request):
             # With the script root: sign-in at /robots/drone/login returns to the drone's page.
@@ -67,13 +69,15 @@ def check_access():
 
 def _forbidden(needed: str):
     return error_response(403, "forbidden",
-                          f"this needs the {needed} role; {current_user.name} is a {current_user.role}")
+                          "this needs the %(needed)s role; %(name)s is a %(role)s",
+                          needed=needed, name=current_user.name, role=current_user.role)
 
 
 def require_role(role: str) -> None:
     """For views whose rule depends on the request body (releasing the e-stop needs an operator)."""
     if _service().sign_in_on() and not role_allows(current_user.role, role):
-        raise ApiError(403, "forbidden", f"this needs the {role} role; {current_user.name} is a {current_user.role}")
+        raise ApiError(403, "forbidden", "this needs the %(role)s role; %(name)s is a %(role2)s",
+                       role=role, name=current_user.name, role2=current_user.role)
 
 
 MAX_NEXT_LEN = 2000
@@ -244,12 +248,12 @@ def _cut(sock) -> None:
 @bp.errorhandler(AccountError)
 def account_error(exc: AccountError):
     status = 404 if exc.code.startswith("no_such") else 409 if exc.code == "user_exists" else 400
-    return error_response(status, exc.code, str(exc))
+    return error_response(status, exc.code, text_of(exc))
 
 
 @bp.errorhandler(InvalidInput)
 def invalid_input(exc: InvalidInput):
-    return error_response(400, exc.code, str(exc))
+    return error_response(400, exc.code, text_of(exc))
 
 
 @bp.get("/api/users")

@@ -11,6 +11,7 @@ from flask import Blueprint, Response, jsonify, request
 from rover_web.auth import signed_in_name
 from rover_web.core.leases import Closed, Full
 from rover_web.core.state import current_feature
+from rover_web.web.api_messages import text_of
 from rover_web.web.connection import peer_gone
 from rover_web.web.http import ApiError, error_response, json_body, too_many
 from rover_web.web.streams import once, opening, refuse_cross_site
@@ -37,12 +38,12 @@ STATUS = {UnknownTopic: 404, Unavailable: 503, CannotSubscribe: 400}
 
 @bp.errorhandler(InvalidInput)
 def invalid_input(exc: InvalidInput):
-    return error_response(400, exc.code, str(exc))
+    return error_response(400, exc.code, text_of(exc))
 
 
 @bp.errorhandler(StreamRefused)
 def stream_refused(exc: StreamRefused):
-    return error_response(STATUS[type(exc)], exc.code, str(exc))
+    return error_response(STATUS[type(exc)], exc.code, text_of(exc))
 
 
 @bp.get("/stream")
@@ -207,8 +208,9 @@ def snapshot():
     finally:
         streams.release(key)
     if got is None:
-        raise ApiError(504, "no_frame", f"no image arrived on {key.topic} within {streams.snapshot_timeout_s:g} s "
-                                        f"(QoS {key.qos}); is the camera publishing?")
+        raise ApiError(504, "no_frame", "no image arrived on %(topic)s within %(snapshot_timeout_s)s s (QoS "
+                                        "%(qos)s); is the camera publishing?",
+                       topic=key.topic, snapshot_timeout_s=format(streams.snapshot_timeout_s, "g"), qos=key.qos)
     jpeg = got[1]
     if jpeg.error is not None:
         status = 415 if jpeg.error_code == "unsupported_encoding" else 422

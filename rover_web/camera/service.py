@@ -11,6 +11,7 @@ from rover_web.core.rate_limit import RateLimit
 from rover_web.core.state import Rover
 from rover_web.ros.graph import publishers_best_effort, topic_types
 from rover_web.ros.typesupport import UnknownMessageType, message_class
+from rover_web.web.api_messages import text_of
 from rover_web.web.validate import InvalidInput
 
 from . import imaging
@@ -139,7 +140,8 @@ class CameraStreams:
         if parsed["msg_type"]:
             msg_type = _image_type(parsed["msg_type"])
             if known and msg_type not in known:
-                raise InvalidInput(f"{topic} carries {', '.join(known)}, not {msg_type}", "type_mismatch")
+                raise InvalidInput("%(topic)s carries %(known)s, not %(msg_type)s", "type_mismatch",
+                                   topic=topic, known=', '.join(known), msg_type=msg_type)
         else:
             if not known:
                 raise UnknownTopic(f"no topic {topic} in the ROS graph (GET /api/topics lists them); to wait for a "
@@ -147,8 +149,9 @@ class CameraStreams:
                                    "unknown_topic")
             images = [t for t in known if t in camera_msgs.IMAGE_TYPES]
             if not images:
-                raise InvalidInput(f"{topic} carries {', '.join(known)}; streams need sensor_msgs/msg/Image "
-                                   f"or sensor_msgs/msg/CompressedImage", "not_an_image_topic")
+                raise InvalidInput("%(topic)s carries %(known)s; streams need sensor_msgs/msg/Image or "
+                                   "sensor_msgs/msg/CompressedImage", "not_an_image_topic",
+                                   topic=topic, known=', '.join(known))
             msg_type = images[0]
         qos = parsed["qos"]
         if qos is None:  # like `ros2 topic echo`: best effort if any publisher is, or nothing would arrive
@@ -269,6 +272,5 @@ def _image_type(name: str) -> str:
     try:
         message_class(name)
     except UnknownMessageType as exc:
-        raise InvalidInput(str(exc), "unknown_type") from None
-    raise InvalidInput(f"{name[:80]} is not an image type; use sensor_msgs/msg/Image or "
-                       f"sensor_msgs/msg/CompressedImage", "not_an_image_type")
+        raise InvalidInput(text_of(exc), "unknown_type") from None
+    raise InvalidInput("%(name)s is not an image type; use sensor_msgs/msg/Image or sensor_msgs/msg/CompressedImage", "not_an_image_type", name=name[:80])

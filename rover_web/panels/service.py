@@ -193,7 +193,8 @@ class PanelService:
             value = state.value_for(control, body)
             confirmed = body.get("confirmed", False)
             if not isinstance(confirmed, bool):
-                raise InvalidInput(f"'confirmed' must be true or false, got {type(confirmed).__name__}", "bad_type")
+                raise InvalidInput("'confirmed' must be true or false, got %(type)s", "bad_type",
+                                   type=type(confirmed).__name__)
         except (InvalidInput, InvalidValue) as exc:
             self._refuse(state, control, body.get("value"), "invalid", InvalidCommand(str(exc), exc.code), client)
         if control.confirm and not confirmed:

@@ -109,13 +109,14 @@ def parse_frame(data: str | bytes, max_bytes: int) -> Drive | Control | Pong:
             if action in obj:
                 only_keys(obj, {action, "seq"} if action == "stop" else {action})
                 if obj[action] is not True:
-                    raise InvalidInput(f"'{action}' must be true", "bad_value")
+                    raise InvalidInput("'%(action)s' must be true", "bad_value", action=action)
                 return Control(action, _seq(obj) if "seq" in obj else None)
         if "pong" in obj:
             only_keys(obj, {"pong"})
             number_ = obj["pong"]
             if isinstance(number_, bool) or not isinstance(number_, int) or not 0 <= number_ < PING_ID_MAX:
-                raise InvalidInput(f"'pong' must be the id of a ping, a whole number below {PING_ID_MAX}", "bad_type")
+                raise InvalidInput("'pong' must be the id of a ping, a whole number below %(ping_id_max)s", "bad_type",
+                                   ping_id_max=PING_ID_MAX)
             return Pong(number_)
         only_keys(obj, DRIVE_KEYS)
         linear = number(obj, "linear", low=-1.0, high=1.0)
@@ -136,5 +137,5 @@ def parse_frame(data: str | bytes, max_bytes: int) -> Drive | Control | Pong:
 def _seq(obj: dict) -> int:
     seq = obj["seq"]
     if isinstance(seq, bool) or not isinstance(seq, int) or not 0 <= seq < WHOLE_MAX:
-        raise InvalidInput(f"'seq' must be a whole number from 0 to {WHOLE_MAX - 1}", "bad_type")
+        raise InvalidInput("'seq' must be a whole number from 0 to %(value)s", "bad_type", value=WHOLE_MAX - 1)
     return seq

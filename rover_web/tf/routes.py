@@ -29,9 +29,11 @@ def api_tf():
 def frame_arg(name: str) -> str:
     value = request.args.get(name, "")
     if not value:
-        raise ApiError(400, "missing_frame", f"{name} is required: a frame id such as map or base_link")
+        raise ApiError(400, "missing_frame", "%(name)s is required: a frame id such as map or base_link", name=name)
     if len(value) > MAX_FRAME_ID or not value.isprintable():
-        raise ApiError(400, "bad_frame", f"{name} must be a printable frame id of at most {MAX_FRAME_ID} characters")
+        raise ApiError(400, "bad_frame", "%(name)s must be a printable frame id of at most %(max_frame_id)s "
+                                         "characters",
+                       name=name, max_frame_id=MAX_FRAME_ID)
     return value
 
 
@@ -42,7 +44,7 @@ def time_arg() -> int | None:
     try:
         seconds = float(raw)
     except ValueError:
-        raise ApiError(400, "bad_time", f"time must be seconds (a number), got {raw[:40]!r}") from None
+        raise ApiError(400, "bad_time", "time must be seconds (a number), got %(raw)s", raw=repr(raw[:40])) from None
     if not math.isfinite(seconds) or seconds < 0 or seconds > 1e10:
         raise ApiError(400, "bad_time", "time must be 0 (the latest common time) or seconds since the epoch")
     return round(seconds * 1e9)

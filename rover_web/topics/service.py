@@ -110,7 +110,8 @@ class TopicBrowser:
             raise UnknownType(f"cannot show {topic}: {exc}", "unknown_type") from None
         type_name = canonical_type(cls)
         if known and type_name not in known:
-            raise InvalidInput(f"{topic} carries {', '.join(known)}, not {type_name}", "type_mismatch")
+            raise InvalidInput("%(topic)s carries %(known)s, not %(type_name)s", "type_mismatch",
+                               topic=topic, known=', '.join(known), type_name=type_name)
         return topic, type_name
 
     def acquire(self, key: tuple[str, str], client: str | None = None) -> TopicEcho:

@@ -58,7 +58,8 @@ def _number(name: str, code: str, default: float, low: float, high: float) -> fl
     except ValueError:
         value = math.nan
     if not math.isfinite(value) or not low <= value <= high:
-        raise ApiError(400, code, f"{name} must be a number from {low:g} to {high:g}, got {raw[:20]!r}")
+        raise ApiError(400, code, "%(name)s must be a number from %(low)s to %(high)s, got %(raw)s",
+                       name=name, low=format(low, "g"), high=format(high, "g"), raw=repr(raw[:20]))
     return value
 
 

@@ -27,12 +27,13 @@ def _parse_channels(raw: str, known: frozenset[str]) -> list[str]:
     channels = [c for c in (part.strip() for part in raw.split(",")) if c]
     if not channels:
         raise ApiError(400, "missing_channels",
-                       f"name channels, e.g. ?channels=status; known: {', '.join(sorted(known))}")
+                       "name channels, e.g. ?channels=status; known: %(known)s",
+                       known=', '.join(sorted(known)))
     unknown = [c for c in channels if c not in known]
     if unknown:
         raise ApiError(400, "unknown_channel",
-                       f"unknown channel(s) {', '.join(c[:32] for c in unknown[:5])}; "
-                       f"known: {', '.join(sorted(known))}")
+                       "unknown channel(s) %(value)s; known: %(known)s",
+                       value=', '.join(c[:32] for c in unknown[:5]), known=', '.join(sorted(known)))
     return channels
 
 
@@ -78,7 +79,7 @@ def events():
         subscription = hub.subscribe(channels, last_event_id)
     except TooManyClients as exc:
         slot.release()
-        raise ApiError(503, "too_many_streams", f"{exc}; close some tabs") from None
+        raise ApiError(503, "too_many_streams", "%(why)s; close some tabs", why=exc) from None
     keepalive_s = config["ROVER_WEB_SSE_KEEPALIVE_S"]
     sock = request.environ.get("werkzeug.socket") or request.environ.get("gunicorn.socket")
     retry = f"retry: {config['ROVER_WEB_SSE_RETRY_MS']}\n\n".encode()

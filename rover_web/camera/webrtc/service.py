@@ -163,8 +163,9 @@ def _check_fingerprints(offer: str) -> None:
 
     for media in SessionDescription.parse(offer).media:
         if not any(f.algorithm in X509_DIGEST_ALGORITHMS for f in media.dtls.fingerprints):
-            raise InvalidInput(f"the offer's {media.kind} section has no DTLS fingerprint this server can check "
-                               f"({', '.join(X509_DIGEST_ALGORITHMS)})", "bad_sdp")
+            raise InvalidInput("the offer's %(kind)s section has no DTLS fingerprint this server can check "
+                               "(%(x509_digest_algorithms)s)", "bad_sdp",
+                               kind=media.kind, x509_digest_algorithms=', '.join(X509_DIGEST_ALGORITHMS))
 
 
 class WebRtcService:
@@ -277,7 +278,8 @@ class WebRtcService:
         and gives it back when it ends, or at once when it cannot be made."""
         key = self.camera.key_for(args)
         if len(offer) > MAX_OFFER_CHARS:
-            raise InvalidInput(f"the offer is longer than {MAX_OFFER_CHARS} characters", "bad_sdp")
+            raise InvalidInput("the offer is longer than %(max_offer_chars)s characters", "bad_sdp",
+                               max_offer_chars=MAX_OFFER_CHARS)
         if not offer.lstrip().startswith("v=0"):
             raise InvalidInput("the body is not an SDP offer (it must start with v=0)", "bad_sdp")
         if "\nm=video " not in offer.replace("\r\n", "\n"):
@@ -374,8 +376,8 @@ class WebRtcService:
             try:
                 await pc.setRemoteDescription(RTCSessionDescription(sdp=_without_mdns(offer), type="offer"))
             except Exception as exc:  # aiortc raises ValueError, KeyError, IndexError... for bad SDP
-                raise InvalidInput(f"the SDP offer could not be used: {str(exc)[:200] or type(exc).__name__}",
-                                   "bad_sdp") from None
+                raise InvalidInput("the SDP offer could not be used: %(value)s",
+                                   "bad_sdp", value=str(exc)[:200] or type(exc).__name__) from None
             _check_fingerprints(offer)
             video = [t for t in pc.getTransceivers() if t.kind == "video"]
             if not video or video[0].direction not in ("recvonly", "sendrecv"):
@@ -390,7 +392,8 @@ class WebRtcService:
                 answer = await pc.createAnswer()
                 await pc.setLocalDescription(answer)
             except Exception as exc:
-                raise InvalidInput(f"no answer can be made to this offer: {str(exc)[:200]}", "bad_sdp") from None
+                raise InvalidInput("no answer can be made to this offer: %(why)s", "bad_sdp",
+                                   why=str(exc)[:200]) from None
         return filter_candidates(pc.localDescription.sdp, self.host_addresses)
 
     def _on_datachannel(self, session: WhepSession, channel) -> None:
