@@ -91,8 +91,12 @@ class AckedStream:
                                "bad_type")
         with self._lock:
             if not 0 <= value <= self._written:
-                raise InvalidInput("'bytes' must be between 0 and %(_written)s (the bytes sent so far), got %(value)s", "out_of_range",
-                                   _written=self._written, value=value if abs(value) < 10**30 else 'a larger number')
+                raise InvalidInput(
+                    "'bytes' must be between 0 and %(_written)s (the bytes sent so far), got %(value)s",
+                    "out_of_range",
+                    _written=self._written,
+                    value=value if abs(value) < 10**30 else "a larger number",
+                )
             if value <= self._acked:
                 return False
             now = self._clock()

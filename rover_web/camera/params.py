@@ -38,9 +38,14 @@ def parse_stream_args(args: Mapping[str, str], *, max_dimension: int, default_qu
     width = _int_arg(args, "width", 1, max_dimension, original_ok=True)
     height = _int_arg(args, "height", 1, max_dimension, original_ok=True)
     if max_pixels and width and height and width * height > max_pixels:
-        raise InvalidInput("%(width)s×%(height)s is more than %(max_pixels)s pixels "
-                           "(ROVER_WEB_CAMERA_MAX_OUTPUT_PIXELS); ask for a smaller size, or one side only", "out_of_range",
-                           width=width, height=height, max_pixels=max_pixels)
+        raise InvalidInput(
+            "%(width)s×%(height)s is more than %(max_pixels)s pixels "
+            "(ROVER_WEB_CAMERA_MAX_OUTPUT_PIXELS); ask for a smaller size, or one side only",
+            "out_of_range",
+            width=width,
+            height=height,
+            max_pixels=max_pixels,
+        )
     quality = _int_arg(args, "quality", 1, 100)
     qos = args.get("qos_profile") or None
     if qos is not None and qos not in QOS_PROFILES:

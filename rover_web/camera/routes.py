@@ -214,7 +214,7 @@ def snapshot():
     jpeg = got[1]
     if jpeg.error is not None:
         status = 415 if jpeg.error_code == "unsupported_encoding" else 422
-        raise ApiError(status, jpeg.error_code or "bad_image", jpeg.error)
+        raise ApiError(status, jpeg.error_code or "bad_image", jpeg.error_text)
     return Response(jpeg.data, mimetype="image/jpeg",
                     headers={**NO_CACHE, "X-Timestamp": f"{jpeg.stamp:.9f}"})
 

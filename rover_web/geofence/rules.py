@@ -26,6 +26,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from rover_web.web.api_messages import explain
 from rover_web.web.validate import InvalidInput
 
 if TYPE_CHECKING:
@@ -91,11 +92,13 @@ class Fence:
         from shapely.geometry import Point
         point = Point(lng, lat)
         if self.keep_in is not None and not self.keep_in.covers(point):
-            return OutsideGeofence(f"({lng:.7f}, {lat:.7f}) is outside every keep-in area of the geofence",
+            return OutsideGeofence(explain("(%(lng)s, %(lat)s) is outside every keep-in area of the geofence",
+                                           lng=format(lng, ".7f"), lat=format(lat, ".7f")),
                                    reason="outside_keep_in", lng=lng, lat=lat)
         for area in self.keep_out:
             if area.geometry.intersects(point):
-                return OutsideGeofence(f"({lng:.7f}, {lat:.7f}) is inside the geofence's {area.title}",
+                return OutsideGeofence(explain("(%(lng)s, %(lat)s) is inside the geofence's %(title)s",
+                                               lng=format(lng, ".7f"), lat=format(lat, ".7f"), title=area.title),
                                        reason="inside_keep_out", lng=lng, lat=lat, feature=area.index,
                                        name=area.name)
         return None
@@ -117,7 +120,9 @@ class Fence:
             refused = self.refusal(lng, lat)
             if refused is not None:
                 refused.details["waypoint"] = i
-                raise OutsideGeofence(f"waypoint {i + 1}: {refused}", **refused.details)
+                raise OutsideGeofence(
+                    explain("waypoint %(value)s: %(refused)s", value=i + 1, refused=refused), **refused.details
+                )
         for i in range(len(points) - 1):
             a, b = points[i], points[i + 1]
             if a == b:
@@ -125,13 +130,23 @@ class Fence:
             leg = LineString([a, b])
             where = dict(leg=[i, i + 1], lng=None, lat=None)
             if self.keep_in is not None and not self.keep_in.covers(leg):
-                raise OutsideGeofence(f"the leg from waypoint {i + 1} to {i + 2} leaves the keep-in area "
-                                      "of the geofence", reason="leg_leaves_keep_in", **where)
+                raise OutsideGeofence(explain("the leg from waypoint %(value)s to %(value2)s leaves the keep-in "
+                                              "area of the geofence",
+                                              value=i + 1, value2=i + 2), reason="leg_leaves_keep_in", **where)
             for area in self.keep_out:
                 if area.geometry.intersects(leg):
-                    raise OutsideGeofence(f"the leg from waypoint {i + 1} to {i + 2} crosses the geofence's "
-                                          f"{area.title}", reason="leg_crosses_keep_out", feature=area.index,
-                                          name=area.name, **where)
+                    raise OutsideGeofence(
+                        explain(
+                            "the leg from waypoint %(value)s to %(value2)s crosses the geofence's %(title)s",
+                            value=i + 1,
+                            value2=i + 2,
+                            title=area.title,
+                        ),
+                        reason="leg_crosses_keep_out",
+                        feature=area.index,
+                        name=area.name,
+                        **where,
+                    )
 
 
 def _feature(area: Area) -> dict:
@@ -222,7 +237,9 @@ def _area(i: int, feature: Any, counter: _VertexCounter) -> Area:
                            "not supported", "antimeridian", where=where)
     reason = shapely.is_valid_reason(shape)
     if reason != "Valid Geometry":
-        raise InvalidInput("%(where)s is not a valid polygon: %(reason)s", "invalid_geometry", where=where, reason=reason)
+        raise InvalidInput(
+            "%(where)s is not a valid polygon: %(reason)s", "invalid_geometry", where=where, reason=reason
+        )
     if shape.area <= 0:
         raise InvalidInput("%(where)s has no area", "invalid_geometry", where=where)
     return Area(i, kind, name, shape)

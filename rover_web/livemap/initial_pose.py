@@ -38,12 +38,22 @@ def covariance(value) -> tuple[float, ...]:
         cells.append(v)
     for row in range(SIDE):
         if cells[row * SIDE + row] < 0:
-            raise InvalidInput("'covariance[%(value)s]' is a variance on the diagonal: it cannot be negative", "out_of_range", value=row * SIDE + row)
+            raise InvalidInput(
+                "'covariance[%(value)s]' is a variance on the diagonal: it cannot be negative",
+                "out_of_range",
+                value=row * SIDE + row,
+            )
         for col in range(row + 1, SIDE):
             a, b = cells[row * SIDE + col], cells[col * SIDE + row]
             if abs(a - b) > SYMMETRY_TOLERANCE * max(1.0, abs(a), abs(b)):
-                raise InvalidInput("'covariance' must be symmetric: [%(value)s] is %(a)s but [%(value2)s] is %(b)s", "bad_value",
-                                   value=row * SIDE + col, a=format(a, "g"), value2=col * SIDE + row, b=format(b, "g"))
+                raise InvalidInput(
+                    "'covariance' must be symmetric: [%(value)s] is %(a)s but [%(value2)s] is %(b)s",
+                    "bad_value",
+                    value=row * SIDE + col,
+                    a=format(a, "g"),
+                    value2=col * SIDE + row,
+                    b=format(b, "g"),
+                )
     return tuple(cells)
 
 

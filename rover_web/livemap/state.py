@@ -23,6 +23,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 from rover_web.config import ROOT
+from rover_web.web.api_messages import explain
 
 from .geometry import wrap_angle
 from .map_files import MapDefinition, load_catalog
@@ -62,7 +63,8 @@ class LiveMap:
         catalog = _catalog_default() if catalog is None else catalog
         definition = catalog.get(map_name)
         if definition is None:
-            raise UnknownMap(f"no map named {map_name!r}; known: {', '.join(catalog)}")
+            raise UnknownMap(explain("no map named %(map_name)s; known: %(catalog)s",
+                                     map_name=repr(map_name), catalog=', '.join(catalog)))
         geometry = definition.geometry
         if cm_per_pixel is None:
             cm_per_pixel = geometry.cm_per_pixel

@@ -20,7 +20,12 @@ MAX_TEXT = 200
 def _query(args) -> dict:
     unknown = sorted(set(args) - {"level", "node", "contains", "limit"})
     if unknown:
-        raise ApiError(400, "unknown_parameter", "unknown parameter %(unknown)s; use level, node, contains, limit", unknown=repr(unknown[0][:40]))
+        raise ApiError(
+            400,
+            "unknown_parameter",
+            "unknown parameter %(unknown)s; use level, node, contains, limit",
+            unknown=repr(unknown[0][:40]),
+        )
     query = {"min_level": 0, "node": "", "contains": "", "limit": DEFAULT_LIMIT}
     if args.get("level"):
         try:

@@ -10,7 +10,7 @@ from rover_web.geofence import OutsideGeofence
 from rover_web.livemap.keep_out import check_goal
 from rover_web.livemap.routes import answer_map_errors
 from rover_web.livemap.service import LiveMapService, OutsideMap, check_on_map
-from rover_web.web.api_messages import text_of
+from rover_web.web.api_messages import explain, text_of
 from rover_web.web.http import ApiError, error_response, json_body
 from rover_web.web.validate import InvalidInput, number, only_keys, text
 
@@ -56,7 +56,7 @@ def _pose(item, where: str) -> tuple[float, float, float]:
     try:
         return number(item, "x"), number(item, "y"), number(item, "yaw", default=0.0)
     except InvalidInput as exc:
-        raise InvalidInput("%(where)s: %(why)s", exc.code, where=where, why=exc) from None
+        raise InvalidInput("%(where)s: %(why)s", exc.code, where=where, why=text_of(exc)) from None
 
 
 def _checked(map_name: str | None, poses: list[tuple[float, float, float]]) -> str:
@@ -74,7 +74,9 @@ def _checked(map_name: str | None, poses: list[tuple[float, float, float]]) -> s
             exc.details["index"] = i
             raise
         except OutsideMap as exc:
-            raise OutsideMap(f"pose {i}: {exc}" if len(poses) > 1 else str(exc)) from None
+            if len(poses) > 1:
+                raise OutsideMap(explain("pose %(i)s: %(why)s", i=i, why=text_of(exc))) from None
+            raise
     return definition.name
 
 
@@ -107,7 +109,7 @@ def post_goal():
     except InvalidInput as exc:
         raise ApiError(400, exc.code, text_of(exc)) from None
     if service.missing is not None:  # after the body check: a bad request is told what is wrong with it first
-        raise Nav2Unavailable("nav2_unavailable", service.missing)
+        raise Nav2Unavailable("nav2_unavailable", service.missing_text)
     name = _checked(map_name, [pose])
     goal = service.send("to_pose", [pose], map_name=name, by=_sender(), watch=on_revoke)
     return jsonify(status="sent", goal=goal)
@@ -130,7 +132,7 @@ def post_route():
     except InvalidInput as exc:
         raise ApiError(400, exc.code, text_of(exc)) from None
     if service.missing is not None:
-        raise Nav2Unavailable("nav2_unavailable", service.missing)
+        raise Nav2Unavailable("nav2_unavailable", service.missing_text)
     name = _checked(map_name, poses)
     goal = service.send(ROUTE_MODES[mode], poses, map_name=name, by=_sender(), watch=on_revoke)
     return jsonify(status="sent", goal=goal)
@@ -145,8 +147,8 @@ def post_cancel():
     except InvalidInput as exc:
         raise ApiError(400, exc.code, text_of(exc)) from None
     if service.missing is not None:
-        raise Nav2Unavailable("nav2_unavailable", service.missing)
+        raise Nav2Unavailable("nav2_unavailable", service.missing_text)
     goal = service.cancel_active("operator", f"canceled by {_sender()}")
     if goal is None:
-        raise NoGoal("no Nav2 goal sent from here is running")
+        raise NoGoal(explain("no Nav2 goal sent from here is running"))
     return jsonify(status="canceling", goal=goal)

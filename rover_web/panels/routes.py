@@ -117,5 +117,5 @@ def command(panel_id: str, control_id: str):
     except ApiError as exc:
         if exc.status != 400:
             raise
-        body = InvalidCommand(exc.message, exc.code)  # still 404 first for an unknown control, then logged
+        body = InvalidCommand(exc.text, exc.code)  # still 404 first for an unknown control, then logged
     return jsonify(service().command(panel_id, control_id, body, _client()))

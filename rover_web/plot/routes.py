@@ -49,7 +49,13 @@ def _seconds(args) -> float:
     except ValueError:
         seconds = math.nan
     if not math.isfinite(seconds) or not 0 < seconds <= MAX_SECONDS:
-        raise ApiError(400, "bad_seconds", "seconds must be a number above 0 and at most %(max_seconds)s, not %(raw)s", max_seconds=format(MAX_SECONDS, ".0f"), raw=repr(raw[:20]))
+        raise ApiError(
+            400,
+            "bad_seconds",
+            "seconds must be a number above 0 and at most %(max_seconds)s, not %(raw)s",
+            max_seconds=format(MAX_SECONDS, ".0f"),
+            raw=repr(raw[:20]),
+        )
     return seconds
 
 

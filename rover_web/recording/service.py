@@ -21,6 +21,7 @@ from rover_web.core.state import Rover
 from rover_web.ros.graph import matching_qos, topic_types
 from rover_web.ros.raw import string_cdr
 from rover_web.ros.raw_taker import RawTaker
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import ApiError
 
 from . import file_index, upload
@@ -114,7 +115,9 @@ class RecordingService:
             self._teardown(active)
             active.recorder.error = f"{type(exc).__name__}: {exc}"[:300]
             active.recorder.stop("subscribe_failed")
-            raise ApiError(503, "subscribe_failed", "could not subscribe to the topics: %(why)s", why=exc) from None
+            raise ApiError(
+                503, "subscribe_failed", "could not subscribe to the topics: %(why)s", why=text_of(exc)
+            ) from None
         self.rover.audit.record("recording.start", by=by, detail=f"recording {recording_id} started",
                                 recording=recording_id, topics=len(channels))
         return self.status(recording_id)
@@ -275,11 +278,17 @@ class RecordingService:
         """507 unless the folder and the disk have room for a recording (or an upload of `adding` bytes)."""
         self.folder.mkdir(mode=0o700, parents=True, exist_ok=True)
         if self._folder_bytes() + adding >= self.folder_max_bytes:
-            raise ApiError(507, "folder_full", "the recordings take ROVER_WEB_RECORDINGS_MAX_MB already"
-                           + (" with this file" if adding else "") + ": delete some first")
+            if adding:
+                raise ApiError(507, "folder_full", "the recordings take ROVER_WEB_RECORDINGS_MAX_MB already with this "
+                                                   "file: delete some first")
+            raise ApiError(
+                507, "folder_full", "the recordings take ROVER_WEB_RECORDINGS_MAX_MB already: delete some first"
+            )
         if shutil.disk_usage(self.folder).free - adding < self.min_free_bytes:
-            raise ApiError(507, "disk_low", "the disk has less free space than ROVER_WEB_RECORDINGS_MIN_FREE_MB"
-                           + (" once this file is stored" if adding else ""))
+            if adding:
+                raise ApiError(507, "disk_low", "the disk has less free space than ROVER_WEB_RECORDINGS_MIN_FREE_MB "
+                                                "once this file is stored")
+            raise ApiError(507, "disk_low", "the disk has less free space than ROVER_WEB_RECORDINGS_MIN_FREE_MB")
 
     def add_uploaded(self, row: dict) -> None:
         """An uploaded file's row (upload.py has checked and renamed the file)."""

@@ -108,6 +108,6 @@ def teleop_command():
         # it, and a revocation stops it at once (rest_drive.py).
         linear_mps, angular_rps = teleop.rest.start(command, speed, duration_s, on_revoke)
     except Refused as exc:
-        raise ApiError(exc.status, exc.code, exc.message) from None
+        raise ApiError(exc.status, exc.code, exc.text) from None
     return jsonify(command=command, speed=speed, duration_s=duration_s, linear_mps=linear_mps,
                    angular_rps=angular_rps)

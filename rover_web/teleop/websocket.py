@@ -29,6 +29,8 @@ import struct
 import threading
 import time
 
+from rover_web.web.api_messages import explain
+
 from .control import Refused, Session, TeleopController
 from .protocol import Control, Drive, FrameError, Pong, parse_frame
 from .ws_frames import (
@@ -106,7 +108,7 @@ def handle_frame(controller: TeleopController, session: Session, data, max_bytes
             controller.release(session)
         elif frame_.action == "estop":
             if controller.request_estop is None:
-                raise Refused("no_estop", "this server has no e-stop to engage", status=501)
+                raise Refused("no_estop", explain("this server has no e-stop to engage"), status=501)
             controller.request_estop(session.name)  # the engage hook tells every socket, this one too
     except Refused as exc:
         return exc.as_frame()

@@ -7,6 +7,7 @@ import math
 from flask import Blueprint, jsonify, render_template, request
 
 from rover_web.core.state import current_feature
+from rover_web.web.api_messages import Text
 from rover_web.web.http import ApiError
 
 from .buffer import TfError
@@ -55,15 +56,15 @@ def transform_json(tf, target: str, source: str) -> dict:
             "rotation": list(tf.rotation), "yaw": tf.yaw, "stamp": tf.stamp_ns / 1e9, "stamp_ns": tf.stamp_ns}
 
 
-def lookup_response(buffer, missing: str | None = None):
+def lookup_response(buffer, missing_text: Text | None = None):
     """The answer to ?target=&source=&time= from `buffer`: the transform, or tf2's reason as a 4xx."""
     target, source, stamp = frame_arg("target"), frame_arg("source"), time_arg()
     try:
         tf = buffer.lookup(target, source, stamp)
     except TfError as exc:
-        if missing and exc.kind == "unknown_frame":
-            raise ApiError(503, "tf_unavailable", missing) from None
-        response = jsonify(error=exc.kind, message=exc.message, detail=exc.detail)
+        if missing_text and exc.kind == "unknown_frame":
+            raise ApiError(503, "tf_unavailable", missing_text) from None
+        response = jsonify(error=exc.kind, message=exc.text.translated(), detail=exc.detail)
         response.status_code = STATUS.get(exc.kind, 400)
         return response
     return jsonify(transform_json(tf, target, source))

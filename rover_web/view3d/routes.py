@@ -36,7 +36,7 @@ def mesh(package: str, path: str):
     try:
         found = resolve(package, path)
     except MeshRefused as exc:
-        raise ApiError(exc.status, exc.code, exc.message) from None
+        raise ApiError(exc.status, exc.code, exc.text) from None
     # A package's file does not change while it is installed; a reinstall changes size or mtime, and
     # so the ETag, and a page that reloads the model asks again (If-None-Match answers 304).
     if request.if_none_match.contains(found.etag):

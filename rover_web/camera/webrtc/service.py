@@ -39,6 +39,7 @@ from rover_web.config import ConfigError
 from rover_web.core.leases import Closed, Full, Leases, ShareUsed
 from rover_web.core.state import Rover
 from rover_web.core.streams import StreamSlot
+from rover_web.web.api_messages import explain, text_of
 from rover_web.web.validate import InvalidInput
 
 from . import frames
@@ -294,22 +295,38 @@ class WebRtcService:
                 session.producer = self.producers.acquire(key, client, None if client is None
                                                           else self.producers_per_client)
             except Closed:
-                raise Unavailable("the server is shutting down", "shutting_down") from None
+                raise Unavailable(explain("the server is shutting down"), "shutting_down") from None
             except ShareUsed as exc:
-                raise Unavailable(f"{exc} different WebRTC camera streams (ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT); "
-                                  "close one first", "too_many_producers") from None
+                raise Unavailable(
+                    explain(
+                        "%(why)s different WebRTC camera streams (ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT); close one first",
+                        why=text_of(exc),
+                    ),
+                    "too_many_producers",
+                ) from None
             except Full:
-                raise Unavailable(f"{len(self.producers)} different WebRTC camera streams are converted already "
-                                  "(ROVER_WEB_CAMERA_MAX_PRODUCERS); view one of them", "too_many_producers") from None
+                raise Unavailable(
+                    explain(
+                        "%(count)s different WebRTC camera streams are converted already "
+                        "(ROVER_WEB_CAMERA_MAX_PRODUCERS); view one of them",
+                        count=len(self.producers),
+                    ),
+                    "too_many_producers",
+                ) from None
             except Exception as exc:
                 log.exception("cannot subscribe to %s", key.topic)
-                raise CannotSubscribe(f"cannot subscribe to {key.topic}: {exc}", "cannot_subscribe") from None
+                raise CannotSubscribe(
+                    explain("cannot subscribe to %(topic)s: %(why)s", topic=key.topic, why=text_of(exc)),
+                    "cannot_subscribe",
+                ) from None
             try:
                 answer = self.loop.run(self._negotiate(session, offer), NEGOTIATE_TIMEOUT_S)
             except LoopStopped:
-                raise Unavailable("the server is shutting down", "shutting_down") from None
+                raise Unavailable(explain("the server is shutting down"), "shutting_down") from None
             except TimeoutError:
-                raise Unavailable("the WebRTC loop did not answer the offer in time", "webrtc_timeout") from None
+                raise Unavailable(
+                    explain("the WebRTC loop did not answer the offer in time"), "webrtc_timeout"
+                ) from None
         except BaseException:
             self._abandon(session)
             raise
@@ -320,18 +337,20 @@ class WebRtcService:
         try:
             with self._lock:
                 if self._closed:
-                    raise Unavailable("the server is shutting down", "shutting_down")
+                    raise Unavailable(explain("the server is shutting down"), "shutting_down")
                 if len(self._sessions) >= self.max_viewers:
-                    raise Unavailable(f"{len(self._sessions)} WebRTC viewers are connected already "
-                                      f"(ROVER_WEB_WEBRTC_MAX_VIEWERS); watch the MJPEG stream instead: "
-                                      f"GET /stream?topic={key.topic}", "too_many_webrtc_viewers")
+                    raise Unavailable(explain("%(count)s WebRTC viewers are connected already "
+                                              "(ROVER_WEB_WEBRTC_MAX_VIEWERS); watch the MJPEG stream instead: GET "
+                                              "/stream?topic=%(topic)s",
+                                              count=len(self._sessions), topic=key.topic), "too_many_webrtc_viewers")
                 # Each session has its own encoder and a place of few: one client must leave the
                 # others some, whatever its share of the much larger stream cap.
                 held = 0 if slot.client is None else sum(s.client == slot.client for s in self._sessions.values())
                 if held >= self.viewers_per_client:
-                    raise Unavailable(f"this client holds {held} WebRTC viewer places already, its share "
-                                      f"(ROVER_WEB_WEBRTC_VIEWERS_PER_CLIENT); close one, or watch the MJPEG "
-                                      f"stream instead: GET /stream?topic={key.topic}", "too_many_webrtc_viewers")
+                    raise Unavailable(explain("this client holds %(held)s WebRTC viewer places already, its share "
+                                              "(ROVER_WEB_WEBRTC_VIEWERS_PER_CLIENT); close one, or watch the "
+                                              "MJPEG stream instead: GET /stream?topic=%(topic)s",
+                                              held=held, topic=key.topic), "too_many_webrtc_viewers")
                 session = WhepSession(secrets.token_urlsafe(16), user, role, may_operate, key, slot)
                 self._sessions[session.id] = session
                 return session

@@ -25,6 +25,31 @@ KEYWORDS = [f"{name}:{index + 1}" for name, index in MESSAGE_ARG.items()]
 # A message that is not a literal may only be a Text carried from where it was written and extracted.
 CARRIERS = {"text_of", "explain", "_http_text"}
 
+# Exceptions whose message reaches a user as an API error's `message` (or a teleop frame's): their
+# message argument (0-based index) must be an explain(...) Text, so it is extracted and translated.
+REFUSALS = {
+    "AccountError": 0, "AdminRefused": 2, "AmbiguousType": 0, "BadFeatures": 0, "CannotSubscribe": 0,
+    "CommandRefused": 0, "EchoRefused": 0, "FieldError": 1, "FrameError": 1, "GoalRejected": 0, "HashingBusy": 0,
+    "ImportRefused": 0, "InvalidCommand": 0, "InvalidLayout": 1, "InvalidValue": 0, "MeshRefused": 2,
+    "Nav2Unavailable": 1, "NoGoal": 0, "NotARecording": 0, "NotPlottable": 0, "NotShown": 1, "OutsideGeofence": 0,
+    "OutsideMap": 0, "PanelError": 0, "ParameterRefused": 2, "ProtocolError": 1, "Refused": 1, "ReleaseRefused": 1,
+    "SchemaNotFound": 0, "ShuttingDown": 0, "StreamRefused": 0, "TfError": 1, "TooCostly": 1, "TooMany": 0,
+    "TooManyClients": 0, "TooManySeries": 0, "TooManyStreams": 1, "Unavailable": 0, "UnknownControl": 0,
+    "UnknownMap": 0, "UnknownMessageType": 0, "UnknownPanel": 0, "UnknownTopic": 0, "UnknownType": 0, "UrdfError": 0,
+    "_bad": 0,  # ros_admin/parameters.py: a ParameterRefused(400, ...)
+    "Refusal": 1,  # panels/state.py: why a control cannot be used now
+}
+# The same name for another class in these folders (a different signature), and what is not a user's.
+REFUSAL_OVERRIDES = {("FieldError", "rover_web/plot/"): 0, ("FrameError", "rover_web/camera/"): 0,
+                     ("CommandRefused", "rover_web/zenoh_link/"): None}
+
+
+def refusal_index(name: str, path: str) -> int | None:
+    for (cls, folder), index in REFUSAL_OVERRIDES.items():
+        if cls == name and path.startswith(folder):
+            return index
+    return REFUSALS.get(name)
+
 
 def _name(func: ast.expr) -> str | None:
     if isinstance(func, ast.Name):
@@ -35,7 +60,7 @@ def _name(func: ast.expr) -> str | None:
 
 
 def _carried(arg: ast.expr) -> bool:
-    if isinstance(arg, ast.Attribute) and arg.attr == "text":
+    if isinstance(arg, ast.Attribute) and arg.attr.endswith("text") or isinstance(arg, ast.Name) and arg.id.endswith("text"):
         return True
     return isinstance(arg, ast.Call) and _name(arg.func) in CARRIERS
 
@@ -49,10 +74,18 @@ def problems(root: Path = PACKAGE) -> list[str]:
             if not isinstance(node, ast.Call):
                 continue
             name = _name(node.func)
+            where = f"{path.relative_to(ROOT)}:{node.lineno} {name}"
+            if name in REFUSALS:
+                index = refusal_index(name, str(path.relative_to(ROOT)))
+                if index is None or len(node.args) <= index:
+                    continue
+                arg = node.args[index]
+                if not _carried(arg):
+                    found.append(f"{where}: message is {type(arg).__name__}, not explain(\"...\") or a carried Text")
+                continue
             if name not in MESSAGE_ARG:
                 continue
             index = MESSAGE_ARG[name]
-            where = f"{path.relative_to(ROOT)}:{node.lineno} {name}"
             if any(isinstance(a, ast.Starred) for a in node.args[:index + 1]) or any(
                     k.arg is None for k in node.keywords):
                 found.append(f"{where}: *args/**kwargs hide the message")
