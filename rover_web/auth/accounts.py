@@ -99,7 +99,7 @@ def check_name(name: str) -> str:
 
 def check_role(role: str) -> str:
     if role not in ROLES:
-        raise AccountError(explain("role must be one of %(ROLES)s", ROLES=', '.join(ROLES)), "bad_role")
+        raise AccountError(explain("role must be one of %(roles)s", roles=', '.join(ROLES)), "bad_role")
     return role
 
 
@@ -107,9 +107,9 @@ def check_password(password: str) -> str:
     if not isinstance(password, str) or not MIN_PASSWORD_LEN <= len(password) <= MAX_PASSWORD_LEN:
         raise AccountError(
             explain(
-                "a password is %(MIN_PASSWORD_LEN)s to %(MAX_PASSWORD_LEN)s characters",
-                MIN_PASSWORD_LEN=MIN_PASSWORD_LEN,
-                MAX_PASSWORD_LEN=MAX_PASSWORD_LEN,
+                "a password is %(min_password_len)s to %(max_password_len)s characters",
+                min_password_len=MIN_PASSWORD_LEN,
+                max_password_len=MAX_PASSWORD_LEN,
             ),
             "bad_password",
         )

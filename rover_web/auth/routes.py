@@ -132,7 +132,7 @@ def login():
     wait_s, why = auth.throttle.admit(username, address)
     if wait_s > 0:
         return _login_refused(as_json, 429, "too_many_attempts",
-                              explain("%(why)s: try again in %(seconds)s s", why=why, seconds=f"{wait_s:.0f}"),
+                              explain("%(why)s: try again in %(seconds)s s", why=why, seconds=format(wait_s, ".0f")),
                               username, next_path, retry_after_s=wait_s)
     try:
         user = auth.accounts.authenticate(username, password)

@@ -55,8 +55,8 @@ def _positions(coords, depth: int, where: str, counter: list[int]):
                                       where=where, coords=coords[0], coords2=coords[1]))
         counter[0] += 1
         if counter[0] > MAX_POSITIONS:
-            raise BadFeatures(explain("more than %(MAX_POSITIONS)s positions: simplify the file first",
-                                      MAX_POSITIONS=format(MAX_POSITIONS, ",")))
+            raise BadFeatures(explain("more than %(max_positions)s positions: simplify the file first",
+                                      max_positions=format(MAX_POSITIONS, ",")))
         yield lng, lat
         return
     if not isinstance(coords, list):
@@ -77,8 +77,8 @@ def check(collection) -> dict:
     if not isinstance(features, list) or not features:
         raise BadFeatures(explain("'features' must be a non-empty array"))
     if len(features) > MAX_FEATURES:
-        raise BadFeatures(explain("%(count)s features; at most %(MAX_FEATURES)s",
-                                  count=format(len(features), ","), MAX_FEATURES=format(MAX_FEATURES, ",")))
+        raise BadFeatures(explain("%(count)s features; at most %(max_features)s",
+                                  count=format(len(features), ","), max_features=format(MAX_FEATURES, ",")))
     for key in ("name", "attribution", "license"):
         if key in collection and not (isinstance(collection[key], str) and len(collection[key]) <= 500):
             raise BadFeatures(explain("'%(key)s' must be a string of at most 500 characters", key=key))
@@ -92,13 +92,13 @@ def check(collection) -> dict:
         props = feature.get("properties")
         kind = props.get("kind") if isinstance(props, dict) else None
         if kind not in KINDS:
-            raise BadFeatures(explain("%(where)s.properties.kind must be one of %(KINDS)s; got %(kind)s",
-                                      where=where, KINDS=', '.join(KINDS), kind=repr(kind)))
+            raise BadFeatures(explain("%(where)s.properties.kind must be one of %(kinds)s; got %(kind)s",
+                                      where=where, kinds=', '.join(KINDS), kind=repr(kind)))
         geometry = feature.get("geometry")
         gtype = geometry.get("type") if isinstance(geometry, dict) else None
         if gtype not in GEOMETRIES:
-            raise BadFeatures(explain("%(where)s.geometry.type must be one of %(GEOMETRIES)s; got %(gtype)s",
-                                      where=where, GEOMETRIES=', '.join(GEOMETRIES), gtype=repr(gtype)))
+            raise BadFeatures(explain("%(where)s.geometry.type must be one of %(geometries)s; got %(gtype)s",
+                                      where=where, geometries=', '.join(GEOMETRIES), gtype=repr(gtype)))
         for lng, lat in _positions(geometry.get("coordinates"), DEPTH[gtype], f"{where}.geometry.coordinates",
                                    counter):
             west, east, south, north = min(west, lng), max(east, lng), min(south, lat), max(north, lat)

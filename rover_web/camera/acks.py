@@ -92,9 +92,9 @@ class AckedStream:
         with self._lock:
             if not 0 <= value <= self._written:
                 raise InvalidInput(
-                    "'bytes' must be between 0 and %(_written)s (the bytes sent so far), got %(value)s",
+                    "'bytes' must be between 0 and %(written)s (the bytes sent so far), got %(value)s",
                     "out_of_range",
-                    _written=self._written,
+                    written=self._written,
                     value=value if abs(value) < 10**30 else "a larger number",
                 )
             if value <= self._acked:

@@ -95,8 +95,8 @@ class Jpeg:
 def image_to_array(image: RawImage) -> np.ndarray:
     """Pixels as an H×W×3 (RGB) or H×W (grey) uint8 array; a view of `data` where possible."""
     if image.encoding not in ENCODINGS:
-        raise FrameError(explain("image encoding %(encoding)s is not supported; supported: %(SUPPORTED)s",
-                                 encoding=repr(image.encoding), SUPPORTED=', '.join(SUPPORTED)),
+        raise FrameError(explain("image encoding %(encoding)s is not supported; supported: %(supported)s",
+                                 encoding=repr(image.encoding), supported=', '.join(SUPPORTED)),
                          "unsupported_encoding")
     bpp, _ = ENCODINGS[image.encoding]
     width, height, step = int(image.width), int(image.height), int(image.step)
@@ -105,8 +105,8 @@ def image_to_array(image: RawImage) -> np.ndarray:
             explain("image is %(width)s×%(height)s: nothing to show", width=width, height=height), "empty_image"
         )
     if width * height > MAX_PIXELS:
-        raise FrameError(explain("image is %(width)s×%(height)s, more than %(MAX_PIXELS)s pixels",
-                                 width=width, height=height, MAX_PIXELS=MAX_PIXELS), "image_too_large")
+        raise FrameError(explain("image is %(width)s×%(height)s, more than %(max_pixels)s pixels",
+                                 width=width, height=height, max_pixels=MAX_PIXELS), "image_too_large")
     if step < width * bpp:
         raise FrameError(explain("step %(step)s is less than width × %(bpp)s bytes (%(value)s) for %(encoding)s",
                                  step=step, bpp=bpp, value=width * bpp, encoding=image.encoding),
@@ -229,8 +229,8 @@ def decode_compressed(frame: CompressedFrame, data: bytes | None = None,
         # Ghostscript), TIFF, ICO and dozens more from bytes any publisher on the graph chooses.
         picture = Image.open(io.BytesIO(data), formats=IMAGE_FORMATS)
         if picture.width * picture.height > MAX_PIXELS:
-            raise FrameError(explain("image is %(width)s×%(height)s, more than %(MAX_PIXELS)s pixels",
-                                     width=picture.width, height=picture.height, MAX_PIXELS=MAX_PIXELS),
+            raise FrameError(explain("image is %(width)s×%(height)s, more than %(max_pixels)s pixels",
+                                     width=picture.width, height=picture.height, max_pixels=MAX_PIXELS),
                              "image_too_large")
         if picture.format == "JPEG" and output_size_of is not None:
             picture.draft("RGB", output_size_of(picture.width, picture.height))

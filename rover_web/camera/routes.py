@@ -11,7 +11,7 @@ from flask import Blueprint, Response, jsonify, request
 from rover_web.auth import signed_in_name
 from rover_web.core.leases import Closed, Full
 from rover_web.core.state import current_feature
-from rover_web.web.api_messages import text_of
+from rover_web.web.api_messages import explain, text_of
 from rover_web.web.connection import peer_gone
 from rover_web.web.http import ApiError, error_response, json_body, too_many
 from rover_web.web.streams import once, opening, refuse_cross_site
@@ -197,7 +197,7 @@ def snapshot():
     streams = current_feature(CameraStreams)
     wait = streams.snapshots.hit(signed_in_name() or request.remote_addr or "")
     if wait:  # each one may subscribe and decode: one client's loop must not cost everyone's frames
-        raise too_many("snapshot requests (ROVER_WEB_CAMERA_SNAPSHOTS_PER_MIN)", wait)
+        raise too_many(explain("snapshot requests (ROVER_WEB_CAMERA_SNAPSHOTS_PER_MIN)"), wait)
     key = streams.key_for(request.args)
     producer = streams.acquire(key)
     try:

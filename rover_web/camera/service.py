@@ -163,9 +163,9 @@ class CameraStreams:
     def acquire(self, key: StreamKey, client: str | None = None) -> FrameProducer:
         with self._lock:
             if self._viewers >= self.max_viewers:
-                raise Unavailable(explain("%(_viewers)s camera viewers are connected already "
+                raise Unavailable(explain("%(viewers)s camera viewers are connected already "
                                           "(ROVER_WEB_CAMERA_MAX_VIEWERS)",
-                                          _viewers=self._viewers), "too_many_viewers")
+                                          viewers=self._viewers), "too_many_viewers")
             self._viewers += 1
         try:
             return self.producers.acquire(key, client, self._share(client))

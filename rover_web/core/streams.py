@@ -70,10 +70,10 @@ class StreamLimit:
                                                          held=held))
             kept = min(reserved, self.limit - 1)
             if not may_reserve and self._common >= self.limit - kept:
-                raise TooManyStreams(self.limit, explain("%(_common)s streams are open; %(kept)s more are kept for "
+                raise TooManyStreams(self.limit, explain("%(common)s streams are open; %(kept)s more are kept for "
                                                          "driving (ROVER_WEB_STREAMS_RESERVED); close a tab or a "
                                                          "camera view",
-                                                         _common=self._common, kept=kept))
+                                                         common=self._common, kept=kept))
             self._count += 1
             self._common += not may_reserve
             self._open[kind] = self._open.get(kind, 0) + 1

@@ -7,7 +7,7 @@ from flask import Blueprint, abort, jsonify, make_response, render_template, req
 
 from rover_web.auth import require_role, signed_in_name
 from rover_web.core.state import current_feature, current_rover
-from rover_web.web.api_messages import text_of
+from rover_web.web.api_messages import explain, text_of
 from rover_web.web.http import ApiError, accepts_form, error_response, json_body, too_many
 from rover_web.web.validate import InvalidInput, only_keys, text
 
@@ -87,7 +87,7 @@ def login_estop():
     # without ROVER_WEB_PROXY_HOPS) with someone who spent it first.
     if wait_s > 0 and fleet_estop.all_engaged:
         if as_json:
-            raise too_many("e-stop engages from the sign-in page, and every robot is already engaged", wait_s)
+            raise too_many(explain("e-stop engages from the sign-in page, and every robot is already engaged"), wait_s)
         return _login_page(429, "every robot's e-stop is already engaged, and this address pressed too often: "
                                 f"try again in {wait_s:.0f} s",
                            retry_after_s=wait_s)

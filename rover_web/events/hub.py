@@ -192,7 +192,7 @@ class EventHub:
     def subscribe(self, channels: Iterable[str], last_event_id: int | None = None) -> Subscription:
         with self._cond:
             if self._clients >= self._max_clients:
-                raise TooManyClients(explain("%(_clients)s event streams are open already", _clients=self._clients))
+                raise TooManyClients(explain("%(clients)s event streams are open already", clients=self._clients))
             self._clients += 1
             channels = frozenset(channels)
             for channel in channels:

@@ -106,5 +106,5 @@ def _invalid_input(exc: InvalidInput):
 
 @bp.errorhandler(NameTaken)
 def _name_taken(exc: NameTaken):
-    return error_response(409, "name_taken", "a layout named %(why)s exists on this robot; choose another name or "
-                                             "PUT that layout", why=repr(str(exc)))
+    return error_response(409, "name_taken", "a layout named %(name)s exists on this robot; choose another name or "
+                                             "PUT that layout", name=repr(str(exc)))

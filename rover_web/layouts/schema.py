@@ -105,18 +105,18 @@ def _first_error(validator, doc: Any, prefix: list) -> None:
             why_text = explain("%(why)s; allowed: none", why=message)
     elif error.validator == "const" and path == ["version"]:
         why_text = explain("this server reads layout version %(version)s; got %(got)s", version=VERSION,
-                           got=f"{error.instance!r:.20}")
+                           got=repr(error.instance)[:20])
     elif error.validator == "maxLength":
         why_text = explain("is longer than %(max_len)s characters", max_len=error.validator_value)
     elif error.validator == "maxItems":
         why_text = explain("holds more than %(max_items)s items", max_items=error.validator_value)
     elif error.validator == "enum":
-        why_text = explain("%(got)s is not one of %(choices)s", got=f"{error.instance!r:.40}",
+        why_text = explain("%(got)s is not one of %(choices)s", got=repr(error.instance)[:40],
                            choices=", ".join(map(str, error.validator_value)))
     elif error.validator == "pattern" and path and path[-1] == "name":
         why_text = explain("must not be blank or hold control characters")
     elif error.validator == "pattern":
-        why_text = explain("%(got)s is not valid here", got=f"{error.instance!r:.80}")
+        why_text = explain("%(got)s is not valid here", got=repr(error.instance)[:80])
     else:  # jsonschema's own English words, as they are
         why_text = explain("%(why)s", why=message if len(message) <= 200 else message[:200] + "…")
     raise InvalidLayout(field_name(path), why_text, CODES.get(error.validator, "bad_value"))
@@ -138,11 +138,11 @@ def validate(doc: Any) -> dict:
         _first_error(settings_validators[card.name], values, ["cards", i, "settings"])
         x, y, w, h = (int(raw[k]) for k in ("x", "y", "w", "h"))
         if x + w > COLUMNS:
-            raise InvalidLayout(f"{where}.w", explain("x + w is %(value)s: the grid is %(COLUMNS)s columns wide",
-                                                      value=x + w, COLUMNS=COLUMNS), "out_of_grid")
+            raise InvalidLayout(f"{where}.w", explain("x + w is %(value)s: the grid is %(columns)s columns wide",
+                                                      value=x + w, columns=COLUMNS), "out_of_grid")
         if y + h > ROWS:
-            raise InvalidLayout(f"{where}.h", explain("y + h is %(value)s: the grid is at most %(ROWS)s rows tall",
-                                                      value=y + h, ROWS=ROWS),
+            raise InvalidLayout(f"{where}.h", explain("y + h is %(value)s: the grid is at most %(rows)s rows tall",
+                                                      value=y + h, rows=ROWS),
                                 "out_of_grid")
         once_key = card.name + (f":{values.get('panel', '')}" if card.name == "panel" else "")
         if card.once or card.name == "panel":

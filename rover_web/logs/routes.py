@@ -35,7 +35,7 @@ def _query(args) -> dict:
     for key in ("node", "contains"):
         value = args.get(key, "")
         if len(value) > MAX_TEXT:
-            raise ApiError(400, f"bad_{key}", "%(key)s is at most %(max_text)s characters", key=key, max_text=MAX_TEXT)
+            raise ApiError(400, "bad_" + key, "%(key)s is at most %(max_text)s characters", key=key, max_text=MAX_TEXT)
         query[key] = value
     if "limit" in args:
         keep = current_feature(RosoutLog).ring.keep

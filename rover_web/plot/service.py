@@ -150,7 +150,7 @@ class Plots:
                     series.users[client] = now
                 return series
             if sum(len(p.series) for p in self._topics.values()) >= MAX_SERIES:
-                raise TooManySeries(explain("%(MAX_SERIES)s series are plotted already", MAX_SERIES=MAX_SERIES))
+                raise TooManySeries(explain("%(max_series)s series are plotted already", max_series=MAX_SERIES))
             if plot_topic is None:
                 echo = self.browser.acquire(key)
                 plot_topic = self._topics[key] = _PlotTopic(key, echo, self.max_message_bytes)

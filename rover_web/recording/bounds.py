@@ -75,10 +75,10 @@ class Budget:
                 "read_budget",
                 explain(
                     "reading this file would decompress more than %(value)s MB (at "
-                    "most %(READ_RATIO)s times the file's size, or %(value2)s MB): "
+                    "most %(read_ratio)s times the file's size, or %(value2)s MB): "
                     "refused",
                     value=self.most // MIB,
-                    READ_RATIO=READ_RATIO,
+                    read_ratio=READ_RATIO,
                     value2=READ_MIN // MIB,
                 ),
             )
@@ -86,8 +86,8 @@ class Budget:
 
     def check_time(self) -> None:
         if time.monotonic() - self.started > TIME_S:
-            raise TooCostly("time_budget", explain("reading this file took more than %(TIME_S)s s: refused",
-                                                   TIME_S=format(TIME_S, "g")))
+            raise TooCostly("time_budget", explain("reading this file took more than %(time_s)s s: refused",
+                                                   time_s=format(TIME_S, "g")))
 
 
 def check_schema(schema: Schema) -> None:
@@ -95,16 +95,16 @@ def check_schema(schema: Schema) -> None:
         raise TooCostly(
             "schema_too_large",
             explain(
-                "schema %(name)s is %(count)s bytes, more than %(SCHEMA_MAX)s",
+                "schema %(name)s is %(count)s bytes, more than %(schema_max)s",
                 name=repr(schema.name[:80]),
                 count=len(schema.data),
-                SCHEMA_MAX=SCHEMA_MAX,
+                schema_max=SCHEMA_MAX,
             ),
         )
     if schema.data.count(b"\n") + 1 > SCHEMA_FIELDS and _fields(schema.data) > SCHEMA_FIELDS:
-        raise TooCostly("schema_too_many_fields", explain("schema %(name)s declares more than %(SCHEMA_FIELDS)s "
+        raise TooCostly("schema_too_many_fields", explain("schema %(name)s declares more than %(schema_fields)s "
                                                           "fields",
-                                                          name=repr(schema.name[:80]), SCHEMA_FIELDS=SCHEMA_FIELDS))
+                                                          name=repr(schema.name[:80]), schema_fields=SCHEMA_FIELDS))
 
 
 def _fields(text: bytes) -> int:
@@ -292,8 +292,8 @@ def records(f, file_size: int, budget: Budget, wanted: Callable[[int], bool] | N
                                                              value=length // MIB, value2=MESSAGE_MAX // MIB))
             if opcode == Opcode.SCHEMA and length > SCHEMA_MAX + 1024:
                 raise TooCostly("schema_too_large", explain("a schema record is %(length)s bytes, more than "
-                                                            "%(SCHEMA_MAX)s",
-                                                            length=length, SCHEMA_MAX=SCHEMA_MAX))
+                                                            "%(schema_max)s",
+                                                            length=length, schema_max=SCHEMA_MAX))
             raw = f.read(length)
             if opcode == Opcode.MESSAGE:
                 yield Located(message_of(memoryview(raw), 0, length, wanted), None)

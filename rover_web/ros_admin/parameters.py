@@ -111,8 +111,8 @@ def check_value(param: dict, value: Any) -> tuple[str, Any]:
         if not isinstance(value, list):
             raise _bad(explain("%(name)s is a %(kind)s: send an array", name=name, kind=kind))
         if len(value) > MAX_ARRAY_ITEMS:
-            raise _bad(explain("%(name)s: at most %(MAX_ARRAY_ITEMS)s items",
-                               name=name, MAX_ARRAY_ITEMS=MAX_ARRAY_ITEMS), "too_long")
+            raise _bad(explain("%(name)s: at most %(max_array_items)s items",
+                               name=name, max_array_items=MAX_ARRAY_ITEMS), "too_long")
         item = kind[:-len("_array")]
         return kind, [_scalar(item, v, f"{name}[{i}]") for i, v in enumerate(value)]
     value = _scalar(kind, value, name)

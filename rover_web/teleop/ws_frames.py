@@ -12,8 +12,6 @@ from __future__ import annotations
 import codecs
 import struct
 
-from rover_web.web.api_messages import explain
-
 OP_CONTINUATION, OP_TEXT, OP_BINARY, OP_CLOSE, OP_PING, OP_PONG = 0x0, 0x1, 0x2, 0x8, 0x9, 0xA
 
 CLOSE_NORMAL = 1000
@@ -34,7 +32,7 @@ class ProtocolError(Exception):
 
     def __init__(self, close_code: int, message: str):
         super().__init__(message)
-        self.close_code, self.message = close_code, str(message)  # a close reason: English, at most 123 bytes
+        self.close_code, self.message = close_code, message
         self.events: list[tuple[str, object]] = []
 
 
@@ -73,14 +71,14 @@ def _close_code_and_reason(payload: bytes) -> tuple[int, str]:
     if not payload:
         return CLOSE_NO_STATUS, ""
     if len(payload) == 1:
-        raise ProtocolError(CLOSE_PROTOCOL_ERROR, explain("a close frame's payload cannot be one byte"))
+        raise ProtocolError(CLOSE_PROTOCOL_ERROR, "a close frame's payload cannot be one byte")
     code = int.from_bytes(payload[:2], "big")
     if code not in _PEER_CLOSE_CODES and not 3000 <= code <= 4999:
-        raise ProtocolError(CLOSE_PROTOCOL_ERROR, explain("close code %(code)s may not be sent", code=code))
+        raise ProtocolError(CLOSE_PROTOCOL_ERROR, f"close code {code} may not be sent")
     try:
         return code, payload[2:].decode("utf-8")
     except UnicodeDecodeError:
-        raise ProtocolError(CLOSE_INVALID_PAYLOAD, explain("the close reason is not UTF-8")) from None
+        raise ProtocolError(CLOSE_INVALID_PAYLOAD, "the close reason is not UTF-8") from None
 
 
 class FrameParser:
@@ -131,9 +129,9 @@ class FrameParser:
         while end - start >= 2:
             b0, b1 = buffer[start], buffer[start + 1]
             if b0 & 0x70:
-                raise ProtocolError(CLOSE_PROTOCOL_ERROR, explain("reserved bits set, but no extension was agreed"))
+                raise ProtocolError(CLOSE_PROTOCOL_ERROR, "reserved bits set, but no extension was agreed")
             if not b1 & 0x80:
-                raise ProtocolError(CLOSE_PROTOCOL_ERROR, explain("a client's frames must be masked"))
+                raise ProtocolError(CLOSE_PROTOCOL_ERROR, "a client's frames must be masked")
             opcode, final, size = b0 & 0x0F, b0 & 0x80, b1 & 0x7F
             head = start + 6
             if size == 126:
@@ -141,17 +139,15 @@ class FrameParser:
                     break
                 size, head = int.from_bytes(buffer[start + 2:start + 4], "big"), start + 8
                 if size < 126:
-                    raise ProtocolError(CLOSE_PROTOCOL_ERROR, explain("a frame length must use the shortest "
-                                                                      "encoding"))
+                    raise ProtocolError(CLOSE_PROTOCOL_ERROR, "a frame length must use the shortest encoding")
             elif size == 127:
                 if end - start < 10:
                     break
                 size, head = int.from_bytes(buffer[start + 2:start + 10], "big"), start + 14
                 if size >> 63:
-                    raise ProtocolError(CLOSE_PROTOCOL_ERROR, explain("a frame length must fit in 63 bits"))
+                    raise ProtocolError(CLOSE_PROTOCOL_ERROR, "a frame length must fit in 63 bits")
                 if size < 1 << 16:
-                    raise ProtocolError(CLOSE_PROTOCOL_ERROR, explain("a frame length must use the shortest "
-                                                                      "encoding"))
+                    raise ProtocolError(CLOSE_PROTOCOL_ERROR, "a frame length must use the shortest encoding")
             self._check_header(opcode, final, size)
             if end < head + size:
                 break
@@ -167,30 +163,25 @@ class FrameParser:
     def _check_header(self, opcode: int, final: int, size: int) -> None:
         if opcode >= OP_CLOSE:
             if opcode > OP_PONG:
-                raise ProtocolError(CLOSE_PROTOCOL_ERROR, explain("unknown opcode %(opcode)s",
-                                                                  opcode=format(opcode, "#x")))
+                raise ProtocolError(CLOSE_PROTOCOL_ERROR, f"unknown opcode {opcode:#x}")
             if not final:
-                raise ProtocolError(CLOSE_PROTOCOL_ERROR, explain("control frames may not be fragmented"))
+                raise ProtocolError(CLOSE_PROTOCOL_ERROR, "control frames may not be fragmented")
             if size > MAX_CONTROL_PAYLOAD:
-                raise ProtocolError(CLOSE_PROTOCOL_ERROR, explain("control frames carry at most 125 bytes"))
+                raise ProtocolError(CLOSE_PROTOCOL_ERROR, "control frames carry at most 125 bytes")
             return
         if opcode == OP_CONTINUATION:
             if self._fragments is None:
-                raise ProtocolError(CLOSE_PROTOCOL_ERROR, explain("a continuation frame with no message to continue"))
+                raise ProtocolError(CLOSE_PROTOCOL_ERROR, "a continuation frame with no message to continue")
             if len(self._fragments) >= self.max_fragments:
-                raise ProtocolError(CLOSE_MESSAGE_TOO_BIG, explain("a message may come in at most "
-                                                                   "%(max_fragments)s frames",
-                                                                   max_fragments=self.max_fragments))
+                raise ProtocolError(CLOSE_MESSAGE_TOO_BIG, f"a message may come in at most {self.max_fragments} frames")
             size += self._fragment_bytes
         elif opcode in (OP_TEXT, OP_BINARY):
             if self._fragments is not None:
-                raise ProtocolError(CLOSE_PROTOCOL_ERROR, explain("a new message began before the last one ended"))
+                raise ProtocolError(CLOSE_PROTOCOL_ERROR, "a new message began before the last one ended")
         else:
-            raise ProtocolError(CLOSE_PROTOCOL_ERROR, explain("unknown opcode %(opcode)s",
-                                                              opcode=format(opcode, "#x")))
+            raise ProtocolError(CLOSE_PROTOCOL_ERROR, f"unknown opcode {opcode:#x}")
         if size > self.max_message_bytes:
-            raise ProtocolError(CLOSE_MESSAGE_TOO_BIG, explain("messages are limited to %(max_message_bytes)s bytes",
-                                                               max_message_bytes=self.max_message_bytes))
+            raise ProtocolError(CLOSE_MESSAGE_TOO_BIG, f"messages are limited to {self.max_message_bytes} bytes")
 
     def _complete(self, opcode: int, final: int, payload: bytes) -> tuple[str, object] | None:
         if opcode >= OP_CLOSE:
@@ -204,7 +195,7 @@ class FrameParser:
                 try:
                     return "text", payload.decode("utf-8")
                 except UnicodeDecodeError:
-                    raise ProtocolError(CLOSE_INVALID_PAYLOAD, explain("a text message must be UTF-8")) from None
+                    raise ProtocolError(CLOSE_INVALID_PAYLOAD, "a text message must be UTF-8") from None
             self._fragments, self._fragment_bytes = [], 0
             # Text is checked fragment by fragment, so bad UTF-8 fails the connection at once.
             self._decoder = codecs.getincrementaldecoder("utf-8")() if opcode == OP_TEXT else None
@@ -213,7 +204,7 @@ class FrameParser:
             try:
                 self._fragments.append(self._decoder.decode(payload, final=bool(final)))
             except UnicodeDecodeError:
-                raise ProtocolError(CLOSE_INVALID_PAYLOAD, explain("a text message must be UTF-8")) from None
+                raise ProtocolError(CLOSE_INVALID_PAYLOAD, "a text message must be UTF-8") from None
         else:
             self._fragments.append(payload)
         if not final:

@@ -124,7 +124,7 @@ class TopicBrowser:
         with self._lock:
             if self._viewers >= self.max_viewers:
                 raise Unavailable(
-                    explain("%(_viewers)s topic echoes are open already", _viewers=self._viewers), "too_many_streams"
+                    explain("%(viewers)s topic echoes are open already", viewers=self._viewers), "too_many_streams"
                 )
             self._viewers += 1
         try:

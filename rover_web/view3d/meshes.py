@@ -72,8 +72,8 @@ def resolve(package: str, path: str) -> MeshFile:
     parts = check_relative(path)
     suffix = os.path.splitext(parts[-1])[1].lower()
     if suffix not in MESH_TYPES:
-        raise MeshRefused(415, "not_a_mesh", explain("only %(MESH_TYPES)s files are served",
-                                                     MESH_TYPES=', '.join(sorted(MESH_TYPES))))
+        raise MeshRefused(415, "not_a_mesh", explain("only %(mesh_types)s files are served",
+                                                     mesh_types=', '.join(sorted(MESH_TYPES))))
     share = os.path.realpath(share_folder(package))
     real = os.path.realpath(os.path.join(share, *parts))
     if os.path.commonpath([share, real]) != share:

@@ -160,8 +160,8 @@ def _invalid(exc: InvalidInput):
 @bp.errorhandler(MissionFull)
 def _full(exc: MissionFull):
     return error_response(409, "too_many_waypoints",
-                          "the mission may hold at most %(args)s waypoints (ROVER_WEB_MAX_WAYPOINTS); delete some "
-                          "first", args=exc.args[0])
+                          "the mission may hold at most %(count)s waypoints (ROVER_WEB_MAX_WAYPOINTS); delete some "
+                          "first", count=exc.args[0])
 
 
 @bp.errorhandler(OutsideGeofence)
@@ -171,15 +171,15 @@ def _outside_geofence(exc: OutsideGeofence):
 
 @bp.errorhandler(WaypointNotFound)
 def _not_found(exc: WaypointNotFound):
-    return error_response(404, "no_such_waypoint", "there is no waypoint with id %(args)s",
-                          args=str(exc.args[0])[:30])
+    return error_response(404, "no_such_waypoint", "there is no waypoint with id %(id)s",
+                          id=str(exc.args[0])[:30])
 
 
 @bp.errorhandler(StaleRevision)
 def _stale(exc: StaleRevision):
     return error_response(409, "mission_changed",
-                          "the mission changed since you loaded it (now revision %(args)s); reload and check it",
-                          args=exc.args[0])
+                          "the mission changed since you loaded it (now revision %(revision)s); reload and check it",
+                          revision=exc.args[0])
 
 
 @bp.errorhandler(EmptyMission)

@@ -24,17 +24,24 @@ log = logging.getLogger(__name__)
 _DOMAIN_NAMES = ("api", "messages")
 
 
-class Text:
-    """An English msgid and the values that fill its placeholders."""
+class Text(str):
+    """An English msgid and the values that fill its placeholders.
 
-    __slots__ = ("msgid", "values")
+    It is also the English text itself (a str): code that compares, searches, logs or serialises a
+    reason keeps working with the English, and only `translated()` gives the request's language.
+    """
 
-    def __init__(self, msgid: str, values: dict[str, Any] | None = None):
-        self.msgid = msgid
-        self.values = values or {}
+    msgid: str
+    values: dict[str, Any]
+
+    def __new__(cls, msgid: str, values: dict[str, Any] | None = None):
+        values = values or {}
+        text = super().__new__(cls, _fill(msgid, values, str))
+        text.msgid, text.values = msgid, values
+        return text
 
     def english(self) -> str:
-        return _fill(self.msgid, self.values, Text.english)
+        return str.__str__(self)
 
     def translated(self) -> str:
         """In the request's language when a catalogue has it; the English otherwise, never an error."""
@@ -48,18 +55,11 @@ class Text:
             log.warning("the translation of %r does not fit its values; answering in English", self.msgid)
             return _fill(self.msgid, self.values, Text.translated)
 
-    def __str__(self) -> str:
-        return self.english()
-
     def __repr__(self) -> str:
         return f"Text({self.msgid!r}, {self.values!r})"
 
-    def __eq__(self, other: object) -> bool:
-        if isinstance(other, Text):
-            return (self.msgid, self.values) == (other.msgid, other.values)
-        return NotImplemented
-
-    __hash__ = None  # values may be unhashable
+    def __reduce__(self):
+        return Text, (self.msgid, self.values)
 
 
 def explain(msgid: str, **values: Any) -> Text:
@@ -100,7 +100,7 @@ def _fill(msgid: str, values: dict[str, Any], render) -> str:
     if not values:
         return msgid
     rendered = {name: render(value) if isinstance(value, Text) else value for name, value in values.items()}
-    return msgid % rendered
+    return str.__str__(msgid % rendered)
 
 
 def _lookup(msgid: str) -> str:

@@ -81,7 +81,7 @@ def number(obj: dict, key: str, *, low: float | None = None, high: float | None 
         raise InvalidInput("'%(key)s' must be finite", "non_finite", key=key)
     if low is not None and value < low or high is not None and value > high:
         raise InvalidInput("'%(key)s' must be between %(low)s and %(high)s, got %(value)s", "out_of_range",
-                           key=key, low=f"{low:g}", high=f"{high:g}", value=f"{value:g}")
+                           key=key, low=format(low, "g"), high=format(high, "g"), value=format(value, "g"))
     return value
 
 

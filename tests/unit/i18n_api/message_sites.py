@@ -32,12 +32,13 @@ REFUSALS = {
     "CommandRefused": 0, "EchoRefused": 0, "FieldError": 1, "FrameError": 1, "GoalRejected": 0, "HashingBusy": 0,
     "ImportRefused": 0, "InvalidCommand": 0, "InvalidLayout": 1, "InvalidValue": 0, "MeshRefused": 2,
     "Nav2Unavailable": 1, "NoGoal": 0, "NotARecording": 0, "NotPlottable": 0, "NotShown": 1, "OutsideGeofence": 0,
-    "OutsideMap": 0, "PanelError": 0, "ParameterRefused": 2, "ProtocolError": 1, "Refused": 1, "ReleaseRefused": 1,
+    "OutsideMap": 0, "PanelError": 0, "ParameterRefused": 2, "Refused": 1, "ReleaseRefused": 1,
     "SchemaNotFound": 0, "ShuttingDown": 0, "StreamRefused": 0, "TfError": 1, "TooCostly": 1, "TooMany": 0,
     "TooManyClients": 0, "TooManySeries": 0, "TooManyStreams": 1, "Unavailable": 0, "UnknownControl": 0,
     "UnknownMap": 0, "UnknownMessageType": 0, "UnknownPanel": 0, "UnknownTopic": 0, "UnknownType": 0, "UrdfError": 0,
     "_bad": 0,  # ros_admin/parameters.py: a ParameterRefused(400, ...)
     "Refusal": 1,  # panels/state.py: why a control cannot be used now
+    "too_many": 0,  # web/http.py: what there were too many of (429)
 }
 # The same name for another class in these folders (a different signature), and what is not a user's.
 REFUSAL_OVERRIDES = {("FieldError", "rover_web/plot/"): 0, ("FrameError", "rover_web/camera/"): 0,
@@ -60,7 +61,10 @@ def _name(func: ast.expr) -> str | None:
 
 
 def _carried(arg: ast.expr) -> bool:
-    if isinstance(arg, ast.Attribute) and arg.attr.endswith("text") or isinstance(arg, ast.Name) and arg.id.endswith("text"):
+    """A Text made where its msgid was written: `exc.text`, a `why_text` variable, text_of(exc), explain(...)."""
+    if isinstance(arg, ast.Attribute) and arg.attr.endswith("text"):
+        return True
+    if isinstance(arg, ast.Name) and arg.id.endswith("text"):
         return True
     return isinstance(arg, ast.Call) and _name(arg.func) in CARRIERS
 
