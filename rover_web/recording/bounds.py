@@ -31,7 +31,7 @@ from mcap.data_stream import ReadDataStream
 from mcap.opcode import Opcode
 from mcap.records import Channel, Footer, Message, Schema
 
-from rover_web.web.api_messages import explain
+from rover_web.web.api_messages import Text, explain
 
 from .reading import Refused
 
@@ -116,7 +116,7 @@ def _fields(text: bytes) -> int:
     return count
 
 
-def _refuse_chunk(declared: int, held: str) -> TooCostly:
+def _refuse_chunk(declared: int, held: Text) -> TooCostly:
     return TooCostly("chunk_too_large", explain("a chunk %(held)s; a chunk may hold at most %(value)s MB (it "
                                                 "declares %(declared)s bytes)",
                                                 held=held, value=CHUNK_MAX // MIB, declared=declared))
@@ -125,7 +125,7 @@ def _refuse_chunk(declared: int, held: str) -> TooCostly:
 def decompress(compression: str, data: bytes, declared: int) -> bytes | bytearray:
     """The chunk's content, never more than min(declared, CHUNK_MAX) bytes made."""
     if declared > CHUNK_MAX:
-        raise _refuse_chunk(declared, f"declares {declared // MIB} MB")
+        raise _refuse_chunk(declared, explain("declares %(mb)s MB", mb=declared // MIB))
     most = declared
     if compression == "":
         if len(data) != declared:
@@ -145,7 +145,7 @@ def decompress(compression: str, data: bytes, declared: int) -> bytes | bytearra
                 filled += n
         view.release()
         if filled > most:
-            raise _refuse_chunk(declared, "holds more than it declares")
+            raise _refuse_chunk(declared, explain("holds more than it declares"))
         del out[filled:]
         return out
     if compression == "lz4":
@@ -154,7 +154,7 @@ def decompress(compression: str, data: bytes, declared: int) -> bytes | bytearra
         decompressor = lz4.frame.LZ4FrameDecompressor()
         out = decompressor.decompress(data, max_length=most + 1)
         if len(out) > most or (not decompressor.eof and not decompressor.needs_input):
-            raise _refuse_chunk(declared, "holds more than it declares")
+            raise _refuse_chunk(declared, explain("holds more than it declares"))
         return out
     raise Refused("corrupt", explain("a chunk is compressed with %(compression)s, which this server does not read",
                                      compression=repr(compression[:20])))
@@ -178,7 +178,7 @@ def _chunk_content(f, at: int, length: int, file_size: int, budget: Budget) -> b
     if at + length > file_size:
         raise Refused("truncated", explain("a chunk runs past the end of the file"))
     if length > CHUNK_MAX + 1024:
-        raise _refuse_chunk(-1, f"is {length // MIB} MB compressed")
+        raise _refuse_chunk(-1, explain("is %(mb)s MB compressed", mb=length // MIB))
     f.seek(at)
     record = f.read(length)
     try:
@@ -192,7 +192,7 @@ def _chunk_content(f, at: int, length: int, file_size: int, budget: Budget) -> b
     if data_length != len(data):
         raise Refused("corrupt", explain("a chunk's data length does not match its record"))
     if declared > CHUNK_MAX:
-        raise _refuse_chunk(declared, f"declares {declared // MIB} MB")
+        raise _refuse_chunk(declared, explain("declares %(mb)s MB", mb=declared // MIB))
     budget.spend(declared)
     content = decompress(compression, data, declared)
     if len(content) != declared:

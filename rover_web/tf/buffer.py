@@ -453,21 +453,19 @@ class TfBuffer:
     @staticmethod
     def _extrapolation(direction: str, stamp: int, nearest: int, frame: _Frame, target: str, source: str) -> TfError:
         by = abs(stamp - nearest) / 1e9
-        edge = "earliest" if direction == "past" else "latest"
+        values = {"by": format(by, ".3f"), "value": format(stamp / 1e9, ".6f"),
+                  "value2": format(nearest / 1e9, ".6f"), "source": source, "target": target}
+        if direction == "past":
+            why_text = explain("Lookup would require extrapolation %(by)s s into the past. Requested time %(value)s "
+                               "but the earliest data is at time %(value2)s, when looking up transform from frame "
+                               "[%(source)s] to frame [%(target)s]", **values)
+        else:
+            why_text = explain("Lookup would require extrapolation %(by)s s into the future. Requested time "
+                               "%(value)s but the latest data is at time %(value2)s, when looking up transform from "
+                               "frame [%(source)s] to frame [%(target)s]", **values)
         return TfError(
             f"extrapolation_{direction}",
-            explain(
-                "Lookup would require extrapolation %(by)s s into the %(direction)s. Requested time %(value)s "
-                "but the %(edge)s data is at time %(value2)s, when looking up transform from frame "
-                "[%(source)s] to frame [%(target)s]",
-                by=format(by, ".3f"),
-                direction=direction,
-                value=format(stamp / 1e9, ".6f"),
-                edge=edge,
-                value2=format(nearest / 1e9, ".6f"),
-                source=source,
-                target=target,
-            ),
+            why_text,
             by_s=by,
             frame=frame.name,
             requested_ns=stamp,
