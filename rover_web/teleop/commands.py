@@ -63,11 +63,7 @@ class Refused(Exception):
         super().__init__(self.text.english())
         self.code, self.message, self.status, self.extra = code, self.text.english(), status, extra
 
-    def as_frame(self) -> dict:
-        return {
-            "type": "error",
-            "error": self.code,
-            "message": self.text.translated(),
-            "status": self.status,
-            **self.extra,
-        }
+    def as_frame(self, catalogues: tuple | None = None) -> dict:
+        """The error frame, its message in the language of `catalogues` (the socket's)."""
+        return {"type": "error", "error": self.code, "message": self.text.translated(catalogues),
+                "status": self.status, **self.extra}

@@ -49,8 +49,8 @@ class FrameError(Exception):
         # `message` stays English: it is also a close frame's reason (at most 123 bytes, for logs).
         self.code, self.message, self.close_code = code, self.text.english(), close_code
 
-    def as_frame(self) -> dict:
-        return {"type": "error", "error": self.code, "message": self.text.translated(), "status": 400}
+    def as_frame(self, catalogues: tuple | None = None) -> dict:
+        return {"type": "error", "error": self.code, "message": self.text.translated(catalogues), "status": 400}
 
 
 class Drive(NamedTuple):  # a tuple: built 40 times a second, and cheaper than a frozen dataclass

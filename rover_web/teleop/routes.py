@@ -10,7 +10,7 @@ from flask import Blueprint, jsonify, request
 
 from rover_web.auth import on_revoke, signed_in_name
 from rover_web.core.state import current_feature, current_rover
-from rover_web.web.api_messages import text_of
+from rover_web.web.api_messages import request_catalogues, text_of
 from rover_web.web.http import ApiError, json_body
 from rover_web.web.streams import stream_slot
 from rover_web.web.validate import InvalidInput, number, only_keys, text
@@ -45,6 +45,7 @@ def teleop_socket(ws) -> None:
     try:
         # Signed in, the session is the user's, whatever name the page asks for.
         session = controller.connect(signed_in_name() or operator_name(request.args.get("name")))
+        session.catalogues = request_catalogues()
         hello = {**controller.session_state(session, "connected"), "type": "hello", "session": session.id,
                  "name": session.name, **teleop.hello()}
         teleop_ws = TeleopSocket(ws, controller, session, teleop.max_frame_bytes)

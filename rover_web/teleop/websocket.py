@@ -93,7 +93,7 @@ def handle_frame(controller: TeleopController, session: Session, data, max_bytes
         controller.stop(session, "bad_input")  # zero if this socket was driving; ignored for viewers
         if exc.close_code is not None:
             raise
-        return exc.as_frame()
+        return exc.as_frame(session.catalogues)
     try:
         if isinstance(frame_, Drive):
             controller.drive(session, frame_.linear, frame_.angular, epoch=frame_.epoch, source=frame_.source,
@@ -111,7 +111,7 @@ def handle_frame(controller: TeleopController, session: Session, data, max_bytes
                 raise Refused("no_estop", explain("this server has no e-stop to engage"), status=501)
             controller.request_estop(session.name)  # the engage hook tells every socket, this one too
     except Refused as exc:
-        return exc.as_frame()
+        return exc.as_frame(session.catalogues)
     return None
 
 

@@ -43,17 +43,24 @@ class Text(str):
     def english(self) -> str:
         return str.__str__(self)
 
-    def translated(self) -> str:
-        """In the request's language when a catalogue has it; the English otherwise, never an error."""
-        translated = _lookup(self.msgid)
+    def translated(self, catalogues: tuple | None = None) -> str:
+        """In the request's language when a catalogue has it; the English otherwise, never an error.
+
+        `catalogues` (from request_catalogues()) is for an answer made outside the request that
+        chose the language: a WebSocket's frames, read on their own thread.
+        """
+        def render(value: Text) -> str:
+            return value.translated(catalogues)
+
+        translated = _lookup(self.msgid, catalogues)
         if translated == self.msgid:
-            return _fill(self.msgid, self.values, Text.translated)
+            return _fill(self.msgid, self.values, render)
         try:
-            return _fill(translated, self.values, Text.translated)
+            return _fill(translated, self.values, render)
         except (KeyError, ValueError, TypeError):
             # A catalogue whose placeholders do not match the msgid's: the English, and say so.
             log.warning("the translation of %r does not fit its values; answering in English", self.msgid)
-            return _fill(self.msgid, self.values, Text.translated)
+            return _fill(self.msgid, self.values, render)
 
     def __repr__(self) -> str:
         return f"Text({self.msgid!r}, {self.values!r})"
@@ -103,16 +110,31 @@ def _fill(msgid: str, values: dict[str, Any], render) -> str:
     return str.__str__(msgid % rendered)
 
 
-def _lookup(msgid: str) -> str:
+def request_catalogues() -> tuple:
+    """The request's language's catalogues, kept by a connection that answers later on another
+    thread (teleop's WebSocket and data channel); () when no Babel is set up: English."""
     if not has_request_context() or "babel" not in current_app.extensions:
-        return msgid  # no Babel set up (a tool, a test app): English
+        return ()
     try:
-        for name in _DOMAIN_NAMES:
-            translated = _domain(name).gettext(msgid)
-            if translated != msgid:
-                return translated
-    except Exception:  # noqa: BLE001 - an unreadable catalogue or locale must never turn an error into a 500
-        log.warning("no translation of an API message could be looked up; answering in English", exc_info=True)
+        return tuple(_domain(name).get_translations() for name in _DOMAIN_NAMES)
+    except Exception:  # noqa: BLE001 - a connection is never refused for its language
+        log.warning("the request's catalogues could not be loaded; its answers will be English", exc_info=True)
+        return ()
+
+
+def _lookup(msgid: str, catalogues: tuple | None = None) -> str:
+    if catalogues is None:
+        if not has_request_context() or "babel" not in current_app.extensions:
+            return msgid  # no Babel set up (a tool, a test app), or no request: English
+        catalogues = request_catalogues()
+    for catalogue in catalogues:
+        try:
+            translated = catalogue.gettext(msgid)
+        except Exception:  # noqa: BLE001 - an unreadable catalogue must never turn an error into a 500
+            log.warning("an API message could not be looked up; answering in English", exc_info=True)
+            return msgid
+        if translated != msgid:
+            return translated
     return msgid
 
 

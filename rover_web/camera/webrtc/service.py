@@ -39,7 +39,7 @@ from rover_web.config import ConfigError
 from rover_web.core.leases import Closed, Full, Leases, ShareUsed
 from rover_web.core.state import Rover
 from rover_web.core.streams import StreamSlot
-from rover_web.web.api_messages import explain, text_of
+from rover_web.web.api_messages import explain, request_catalogues, text_of
 from rover_web.web.validate import InvalidInput
 
 from . import frames
@@ -91,6 +91,7 @@ class WhepSession:
     state: str = "new"
     last_connected: float | None = None
     ended: str | None = None  # why it ended
+    catalogues: tuple | None = None  # the offer's language, for the data channel's error frames
     remb_bps: int | None = None  # the browser's latest estimate, unclamped
     link_share: float = 1.0  # of that estimate, what the video may use (ROVER_WEB_WEBRTC_LINK_SHARE)
     loss_keyframes: int = 0  # keyframes sent instead of resending what could not help (feedback.py)
@@ -351,7 +352,8 @@ class WebRtcService:
                                               "(ROVER_WEB_WEBRTC_VIEWERS_PER_CLIENT); close one, or watch the "
                                               "MJPEG stream instead: GET /stream?topic=%(topic)s",
                                               held=held, topic=key.topic), "too_many_webrtc_viewers")
-                session = WhepSession(secrets.token_urlsafe(16), user, role, may_operate, key, slot)
+                session = WhepSession(secrets.token_urlsafe(16), user, role, may_operate, key, slot,
+                                      catalogues=request_catalogues())
                 self._sessions[session.id] = session
                 return session
         except BaseException:
@@ -423,14 +425,17 @@ class WebRtcService:
             channel.close()
             return
         if not session.may_operate or session.teleop is not None:
-            why = (f"driving needs the operator role; {session.user} is a {session.role}" if not session.may_operate
-                   else "this session has a teleop channel already")
-            channel.send(json.dumps({"type": "error", "error": "forbidden", "status": 403, "message": why}))
+            why = (explain("driving needs the operator role; %(name)s is a %(role)s", name=session.user,
+                           role=session.role) if not session.may_operate
+                   else explain("this session has a teleop channel already"))
+            channel.send(json.dumps({"type": "error", "error": "forbidden", "status": 403,
+                                     "message": why.translated(session.catalogues)}))
             channel.close()
             return
         teleop = self.rover.feature(TeleopService)
         glue = TeleopChannel(channel, teleop.controller, session.user, teleop.hello(), teleop.max_frame_bytes,
                              call_soon=self.loop.call_soon, call_later=self.loop.loop.call_later, pool=self._teleop)
+        glue.session.catalogues = session.catalogues
         session.teleop = glue
         channel.on("message", glue.on_message)
         channel.on("close", glue.close)

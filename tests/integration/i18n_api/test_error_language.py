@@ -139,3 +139,25 @@ def test_nothing_is_changed_by_a_refused_request_in_another_language(server):
     for lang in (None, *LANGUAGES):
         assert _ask(server, "POST", "/api/waypoints", lang, json={"lng": 500, "lat": 0}).status_code == 400
     assert _ask(server, "GET", "/api/waypoints", "ja").json() == before
+
+
+def test_a_teleop_error_frame_is_in_the_language_the_socket_was_opened_with(server):
+    # The frame is refused on the socket's reader thread, outside any request: the language is the
+    # one the handshake asked for, kept by the session.
+    from tests.support.teleop_support import TeleopClient
+
+    msgid = "'%(key)s' must be between %(low)s and %(high)s, got %(value)s"
+    values = {"key": "linear", "low": "-1", "high": "1", "value": "5"}
+    answers = {}
+    for lang in (None, *LANGUAGES):
+        client = TeleopClient(server.url, header=[f"Accept-Language: {lang}"] if lang else [])
+        try:
+            client.send({"linear": 5, "angular": 0})
+            answers[lang] = client.wait_errors(1)[0]
+        finally:
+            client.close()
+    assert {frame["error"] for frame in answers.values()} == {"out_of_range"}
+    assert answers[None]["message"] == msgid % values
+    for lang in LANGUAGES:
+        assert answers[lang]["message"] == _catalogue(lang)[msgid] % values
+        assert answers[lang]["message"] != answers[None]["message"]
