@@ -16,6 +16,7 @@ from flask import Flask
 from rover_web import config as config_module
 from rover_web import process
 from rover_web.config import ROOT, ConfigError
+from rover_web.i18n import N_
 from rover_web.ros import RosUnavailable, require_rclpy
 
 log = logging.getLogger(__name__)
@@ -60,8 +61,10 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
         return app
     if process.is_cli_command_lookup():
         return app  # a CLI command, not a server: no node, no database, no stop-on-exit hooks
+    from rover_web import i18n
     from rover_web.web import assets
 
+    i18n.init_app(app)  # robot and hub: the pages' language; before assets, which serves the browser's catalogues
     assets.init_app(app)  # hashed, pre-compressed static files and each page's modules named up front
     if settings["ROVER_WEB_HUB"]:
         from rover_web import hub  # a fleet hub: robots heard over Zenoh, and no ROS at all
@@ -160,7 +163,7 @@ def _create_app(test_config: Mapping[str, Any] | None) -> Flask:
             db_claim.release()
         raise
     app.register_blueprint(pages.bp)
-    graph.add_nav("Status", "/status")
+    graph.add_nav(N_("Status"), "/status")
     app.register_blueprint(status.bp)
     app.register_blueprint(sse.bp)
     apidocs.init_app(app, graph)  # after every route: it describes them all (docs/api.md)

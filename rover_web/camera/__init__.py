@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover, current_feature
+from rover_web.i18n import N_
 
 from . import routes, webrtc
 from .service import CameraStreams
@@ -30,4 +31,4 @@ def _init_robot(rover: Rover) -> None:
     rover.add_feature(streams)
     streams.producers.start_reaper("camera-reaper")
     rover.on_shutdown(streams.close)
-    rover.add_panel(20, "panels/camera.html", "Camera")
+    rover.add_panel(20, "panels/camera.html", N_("Camera"))

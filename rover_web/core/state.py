@@ -19,6 +19,7 @@ from rover_web.core.loops import Loop, every
 from rover_web.core.robots import Robot
 from rover_web.core.streams import StreamLimit
 from rover_web.events.audit import AuditHub
+from rover_web.i18n import N_
 
 if TYPE_CHECKING:
     from rover_web.events.broadcast import Broadcaster
@@ -82,7 +83,7 @@ class Rover:
         self.streams = streams or StreamLimit(config["ROVER_WEB_MAX_STREAMS"])
         self.dashboard_panels: list[DashboardPanel] = []
         # Every robot has the same features, so one list of links serves them all.
-        self.nav_links: list[tuple[str, str]] = [("Dashboard", "/")] if nav_links is None else nav_links
+        self.nav_links: list[tuple[str, str]] = [(N_("Dashboard"), "/")] if nav_links is None else nav_links
         self._features: dict[type, object] = {}
         self._loops: list[Loop] = []
         self.link_lost_hooks: list[Callable[[], None]] = []

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
+from rover_web.i18n import N_
 
 from . import routes
 from .service import REFRESH_S, Diagnostics
@@ -26,6 +27,6 @@ def _init_robot(rover: Rover) -> None:
     rover.add_feature(diagnostics)
     rover.hub.register("diagnostics")
     diagnostics.subscribe()
-    rover.add_nav("Diagnostics", "/diagnostics")
-    rover.add_panel(80, "panels/diagnostics.html", "Diagnostics", channels=("diagnostics",))
+    rover.add_nav(N_("Diagnostics"), "/diagnostics")
+    rover.add_panel(80, "panels/diagnostics.html", N_("Diagnostics"), channels=("diagnostics",))
     rover.every(REFRESH_S, diagnostics.refresh, name="diagnostics-refresh")

@@ -29,6 +29,7 @@ from rover_web.core.state import Rover
 from rover_web.core.streams import StreamLimit
 from rover_web.events.broadcast import Broadcaster
 from rover_web.events.hub import EventHub
+from rover_web.i18n import N_
 from rover_web.ros.cmd_vel import CmdVelOutput
 from rover_web.storage.claim import claim
 from rover_web.storage.db import Database
@@ -92,4 +93,4 @@ def init_app(app: Flask, fleet: Fleet) -> None:
     app.context_processor(routes.layout_context)
     app.wsgi_app = RobotPrefix(app.wsgi_app, fleet.names)
     if len(fleet) > 1:
-        fleet.graph.add_nav("Robots", "/robots")
+        fleet.graph.add_nav(N_("Robots"), "/robots")

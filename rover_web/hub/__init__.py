@@ -31,6 +31,7 @@ from rover_web.core.robots import Robot
 from rover_web.core.state import EXTENSION, Rover
 from rover_web.events.broadcast import Broadcaster
 from rover_web.events.hub import EventHub
+from rover_web.i18n import N_
 from rover_web.zenoh_link.session import link_settings, open_session
 
 from .directory import Directory
@@ -129,7 +130,7 @@ def create(app: Flask, settings: dict, testing: bool) -> Flask:
         events = EventHub(max_clients=settings["ROVER_WEB_SSE_MAX_CLIENTS"])
         broadcaster = Broadcaster(events, settings["ROVER_WEB_SSE_KEEPALIVE_S"])
         rover = Rover(config, events, hub, None, db=db, broadcaster=broadcaster,
-                      robot=Robot("hub", kind="robot"), nav_links=[("Robots", "/robots")])
+                      robot=Robot("hub", kind="robot"), nav_links=[(N_("Robots"), "/robots")])
         rover.on_shutdown(held.release)
         rover.on_shutdown(db.close)
         rover.add_feature(hub)

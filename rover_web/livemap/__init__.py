@@ -15,6 +15,7 @@ from __future__ import annotations
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
+from rover_web.i18n import N_
 
 from . import msgs, routes
 from .service import STALE_CHECK_S, LiveMapService, load_files
@@ -45,8 +46,8 @@ def _init_robot(rover: Rover) -> None:
         runtime.subscribe(msgs.OCCUPANCY_GRID, service.map_topic, lambda m: service.on_grid(*msgs.occupancy_grid(m)),
                           "latched")
 
-    rover.add_panel(30, "panels/livemap.html", "Live map", channels=("pose",))
-    rover.add_nav("Live map", "/livemap")
+    rover.add_panel(30, "panels/livemap.html", N_("Live map"), channels=("pose",))
+    rover.add_nav(N_("Live map"), "/livemap")
     rover.every(STALE_CHECK_S, service.check_staleness, name="livemap-staleness")
     if service.placer.buffer is not None:
         rover.every(service.tf_pose_period_s, service.pose_from_tf, name="livemap-tf-pose")

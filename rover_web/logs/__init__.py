@@ -10,6 +10,7 @@ Modules: ring (the bounded ring, filters, grouping of repeats), msgs.
 from __future__ import annotations
 
 from rover_web.core.state import Rover
+from rover_web.i18n import N_
 
 from . import routes
 from .service import BATCH_PERIOD_S, HEALTH_PERIOD_S, RosoutLog
@@ -21,6 +22,6 @@ def init_app(app, rover: Rover) -> None:
     rover.hub.register("rosout", "rosout_health")
     log.subscribe()
     app.register_blueprint(routes.bp)
-    rover.add_nav("Logs", "/logs")
+    rover.add_nav(N_("Logs"), "/logs")
     rover.every(BATCH_PERIOD_S, log.flush, name="rosout-batches")
     rover.every(HEALTH_PERIOD_S, log.publish_health, name="rosout-health", immediately=True)

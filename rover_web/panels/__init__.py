@@ -12,6 +12,7 @@ from __future__ import annotations
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
+from rover_web.i18n import N_
 
 from . import routes, spec
 from .msgs import field_kind
@@ -36,7 +37,7 @@ def _init_robot(rover: Rover) -> None:
     rover.add_feature(service)
     estop.on_engage(service.on_estop)
     estop.on_release(lambda _by: service.publish_view())  # the page's buttons come back
-    rover.add_panel(20, "panels/panels.html", "Control panels", channels=("panel",))
-    rover.add_nav("Panels", "/panels")
+    rover.add_panel(20, "panels/panels.html", N_("Control panels"), channels=("panel",))
+    rover.add_nav(N_("Panels"), "/panels")
     service.publish_view()
     rover.every(TICK_S, service.tick, name="panels-ticker")

@@ -11,6 +11,7 @@ Modules: field (paths, reading a number), series (ring, decimation), msgs (numer
 from __future__ import annotations
 
 from rover_web.core.state import Rover
+from rover_web.i18n import N_
 
 from . import routes
 from .service import TICK_S, Plots
@@ -21,6 +22,6 @@ def init_app(app, rover: Rover) -> None:
     rover.add_feature(plots)
     rover.hub.register("plot")
     app.register_blueprint(routes.bp)
-    rover.add_nav("Plot", "/plot")
+    rover.add_nav(N_("Plot"), "/plot")
     rover.every(TICK_S, plots.tick, name="plot-tick", only_while=plots.plotting)
     rover.on_shutdown(plots.close)

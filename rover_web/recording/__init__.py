@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from rover_web.config import ConfigError
+from rover_web.i18n import N_
 
 from .replay import init_cli
 
@@ -64,5 +65,5 @@ def init_app(app, fleet: Fleet) -> None:
         service = RecordingService(rover, folder, RecordingIndex(rover.db), extra_audit=(fleet.graph.audit,))
         rover.add_feature(service)
         rover.on_shutdown(service.shutdown)
-        rover.add_nav("Recordings", "/recordings")
+        rover.add_nav(N_("Recordings"), "/recordings")
     app.register_blueprint(routes.bp)

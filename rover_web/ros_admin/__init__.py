@@ -21,6 +21,7 @@ from flask import Flask
 from rover_web.config import ConfigError, defaults
 from rover_web.core.state import Rover
 from rover_web.estop import FleetEStop
+from rover_web.i18n import N_
 
 from . import routes
 from .access import dropped, parse_rules
@@ -45,7 +46,7 @@ def init_app(app: Flask, rover: Rover) -> None:
     estop.on_engage(admin.on_estop)
     app.register_blueprint(routes.bp)
     if admin.mode != "off":
-        rover.add_nav("ROS", "/ros")
+        rover.add_nav(N_("ROS"), "/ros")
 
 
 def warn_dropped_defaults(deny) -> None:

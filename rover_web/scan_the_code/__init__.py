@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover, current_feature
+from rover_web.i18n import N_
 
 from . import routes
 from .service import CODE_CHANNEL, STATE_CHANNEL, ScanTheCodeService, sequence_from_config
@@ -41,4 +42,4 @@ def _init_robot(rover: Rover) -> None:
                             lambda msg: service.observe(msgs.text_of(msg)),
                             qos=config["ROVER_WEB_LIGHT_SEQUENCE_QOS"])
     rover.every(service.freshness_period_s, service.check_fresh, name="light-sequence-freshness")
-    rover.add_panel(30, "panels/scan_the_code.html", "Scan the Code", channels=(STATE_CHANNEL,))
+    rover.add_panel(30, "panels/scan_the_code.html", N_("Scan the Code"), channels=(STATE_CHANNEL,))

@@ -13,6 +13,7 @@ import math
 
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
+from rover_web.i18n import N_
 
 from . import msgs
 
@@ -39,4 +40,4 @@ def _init_robot(rover: Rover) -> None:
     rover.runtime.subscribe(msgs.BATTERY_STATE, rover.config["ROVER_WEB_BATTERY_TOPIC"],
                             lambda msg: rover.hub.publish_throttled("battery", msgs.battery_summary(msg),
                                                                     BATTERY_MAX_HZ), qos="sensor_data")
-    rover.add_panel(10, "panels/odom.html", "Robot", channels=("odom", "battery"))
+    rover.add_panel(10, "panels/odom.html", N_("Robot"), channels=("odom", "battery"))

@@ -24,6 +24,7 @@ from flask_sock import Sock
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
+from rover_web.i18n import N_
 
 from . import routes
 from .service import CHANNEL, CHANNEL_MAX_HZ, TeleopService
@@ -52,7 +53,7 @@ def _init_robot(rover: Rover) -> None:
     rover.add_feature(teleop)
     rover.hub.register(CHANNEL)
     rover.hub.publish_throttled(CHANNEL, teleop.controller.state(), CHANNEL_MAX_HZ)
-    rover.add_panel(5, "panels/teleop.html", "Drive", channels=(CHANNEL,))
+    rover.add_panel(5, "panels/teleop.html", N_("Drive"), channels=(CHANNEL,))
 
     if teleop.controller.estop["engaged"]:
         log.warning("the e-stop is engaged (since the last run); release it to drive")

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
+from rover_web.i18n import N_
 
 from . import routes
 from .buffer import TfBuffer, TfError, Transform
@@ -33,7 +34,7 @@ def init_app(app, fleet: Fleet) -> None:
 def add_nav(fleet: Fleet) -> None:
     """The TF page's link, among the pages that observe the robot (init_app runs early, before them)."""
     for rover in fleet:
-        rover.add_nav("TF", "/tf")
+        rover.add_nav(N_("TF"), "/tf")
 
 
 def _init_robot(rover: Rover, msgs, missing) -> None:

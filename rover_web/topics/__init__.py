@@ -11,6 +11,7 @@ last viewer leaves.
 from __future__ import annotations
 
 from rover_web.core.state import Rover
+from rover_web.i18n import N_
 
 from . import routes
 from .service import TopicBrowser
@@ -21,7 +22,7 @@ def init_app(app, rover: Rover) -> None:
     rover.add_feature(browser)
     rover.hub.register("topics")
     app.register_blueprint(routes.bp)
-    rover.add_nav("Topics", "/topics")
+    rover.add_nav(N_("Topics"), "/topics")
     rover.every(browser.refresh_s, browser.refresh, name="topics-refresh", immediately=True)
     browser.echoes.start_reaper("topics-echo-reaper")
     rover.on_shutdown(browser.close)

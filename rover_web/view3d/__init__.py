@@ -16,6 +16,7 @@ import logging
 
 from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover
+from rover_web.i18n import N_
 from rover_web.overlays.bounds import MARKERS_MAX_BYTES, bounded
 from rover_web.tf import TfService
 
@@ -40,7 +41,7 @@ def _init_robot(rover: Rover) -> None:
     service = View3dService(rover)
     rover.add_feature(service)
     rover.hub.register(*CHANNELS)
-    rover.add_nav("3D", "/3d")
+    rover.add_nav(N_("3D"), "/3d")
     tf = rover.feature(TfService)  # set up before this feature (create_app)
     service.tf, service.tf_missing = tf.buffer, tf.missing
     runtime = rover.runtime

@@ -23,6 +23,7 @@ from rover_web.core.fleet import Fleet
 from rover_web.core.state import Rover, current_feature
 from rover_web.estop import EStopService
 from rover_web.geofence import GeofenceService
+from rover_web.i18n import N_
 
 from . import broadcaster, routes
 from .msgs import HEADING_TYPES, NAV_SAT_FIX, fix_reading, heading_orientation, odometry_yaw
@@ -61,6 +62,6 @@ def _init_robot(rover: Rover) -> None:
     service.broadcaster.start()
     rover.on_shutdown(service.broadcaster.stop)
     rover.on_shutdown(service.store.close)  # runs first: queued changes commit before the db closes
-    rover.add_panel(20, "panels/waypoints.html", "GPS waypoints",
+    rover.add_panel(20, "panels/waypoints.html", N_("GPS waypoints"),
                     channels=(broadcaster.CHANNEL, FIX_CHANNEL, HEADING_CHANNEL))
-    rover.add_nav("Waypoints", "/waypoints")
+    rover.add_nav(N_("Waypoints"), "/waypoints")

@@ -95,21 +95,25 @@ def _write_atomically(path: Path, data: bytes) -> None:
     os.replace(tmp, path)
 
 
-def build(static_dir: Path, build_dir: Path) -> Manifest:
+def _sources(static_dir: Path, generated: dict[str, bytes]):
+    for path in sorted(static_dir.rglob("*")):
+        if path.is_file() and not any(part.startswith(".") for part in path.relative_to(static_dir).parts):
+            yield path.relative_to(static_dir).as_posix(), path.read_bytes()
+    yield from sorted(generated.items())
+
+
+def build(static_dir: Path, build_dir: Path, generated: dict[str, bytes] | None = None) -> Manifest:
     """Hash every file of static_dir; copy and compress into build_dir what it does not hold yet.
 
     The store is content-addressed, so a copy is never stale and two servers (or an old page still
     open after an upgrade) share it safely. The plain copy is written last: its presence says its
-    .br and .gz are complete.
+    .br and .gz are complete. `generated` are files made at start ({name: content}, such as the
+    browser's translation catalogues, rover_web/i18n), served exactly as if they were in static_dir.
     """
     manifest = Manifest()
     compressor = Compressor(quiet=True)
     made = 0
-    for path in sorted(static_dir.rglob("*")):
-        if not path.is_file() or any(part.startswith(".") for part in path.relative_to(static_dir).parts):
-            continue
-        name = path.relative_to(static_dir).as_posix()
-        data = path.read_bytes()
+    for name, data in _sources(static_dir, generated or {}):
         digest = hashlib.sha256(data).hexdigest()[:HASH_CHARS]
         hashed = hashed_name(name, digest)
         manifest.hashed[name] = hashed
@@ -171,7 +175,8 @@ def init_app(app: Flask) -> None:
     build_dir = build_dir_for(static_dir, app.config.get("ROVER_WEB_STATIC_BUILD_DIR"))
     try:
         build_dir.mkdir(parents=True, exist_ok=True)
-        manifest = build(static_dir, build_dir)
+        # Files made at start by a feature set up before this (the i18n catalogues), beside static/'s.
+        manifest = build(static_dir, build_dir, app.extensions.get("rover_web.generated_static"))
     except OSError as exc:
         # A read-only install still serves every page, only without long caching or compression.
         log.warning("static files are served un-hashed and uncompressed: %s is not writable (%s); "
