@@ -16,12 +16,10 @@ import logging
 from typing import Any
 
 from flask import current_app, has_request_context
+from flask_babel import get_domain
 
 log = logging.getLogger(__name__)
 
-# The staging domain of the API's messages, then the app's one catalogue (the lead folds api.po
-# into messages.po at merge; looking in both keeps either layout working).
-_DOMAIN_NAMES = ("api", "messages")
 
 
 class Text(str):
@@ -98,11 +96,6 @@ def as_text(message: str | Text, values: dict[str, Any]) -> Text:
     return Text(message, values)
 
 
-def N_(msgid: str) -> str:  # noqa: N802 - gettext's name for "translate later", known to every extractor
-    """Mark a msgid kept in a table and used as an ApiError/error_response message elsewhere."""
-    return msgid
-
-
 def _fill(msgid: str, values: dict[str, Any], render) -> str:
     if not values:
         return msgid
@@ -116,7 +109,8 @@ def request_catalogues() -> tuple:
     if not has_request_context() or "babel" not in current_app.extensions:
         return ()
     try:
-        return tuple(_domain(name).get_translations() for name in _DOMAIN_NAMES)
+        # The app's one catalogue (rover_web/i18n folds every .po of a language, api.po included).
+        return (get_domain().get_translations(),)
     except Exception:  # noqa: BLE001 - a connection is never refused for its language
         log.warning("the request's catalogues could not be loaded; its answers will be English", exc_info=True)
         return ()
@@ -137,12 +131,3 @@ def _lookup(msgid: str, catalogues: tuple | None = None) -> str:
             return translated
     return msgid
 
-
-def _domain(name: str):
-    # One per app: a Domain caches its catalogues, which come from that app's translation directories.
-    domains = current_app.extensions.setdefault("rover_web_api_domains", {})
-    domain = domains.get(name)
-    if domain is None:
-        from flask_babel import Domain  # only where Babel is set up on the app
-        domain = domains[name] = Domain(domain=name)
-    return domain

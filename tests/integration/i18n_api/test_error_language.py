@@ -12,13 +12,11 @@ import re
 
 import pytest
 import requests
-from babel.messages.mofile import write_mo
 from babel.messages.pofile import read_po
 
 from rover_web.config import ROOT
 
 LANGUAGES = ("es", "ja")
-SHIPPED = ("en", "es", "ja")
 
 
 def _catalogue(lang: str) -> dict[str, str]:
@@ -26,36 +24,11 @@ def _catalogue(lang: str) -> dict[str, str]:
         return {m.id: m.string for m in read_po(f) if m.id}
 
 
-def _with_api_catalogues(app, folder) -> None:
-    """The API catalogues compiled where the app's Babel looks, as the app's start-up compile does.
-
-    Until the lead folds api.po into messages.po, the app's own catalogue lacks these messages; an
-    app without Babel yet (before the i18n-core branch) gets Flask-Babel with a selector reading
-    Accept-Language, as rover_web/i18n does.
-    """
-    from flask import request
-    from flask_babel import Babel, get_babel
-
-    for lang in LANGUAGES:
-        target = folder / lang / "LC_MESSAGES"
-        target.mkdir(parents=True)
-        with (ROOT / "translations" / lang / "LC_MESSAGES" / "api.po").open("rb") as f:
-            catalogue = read_po(f, locale=lang)
-        with (target / "api.mo").open("wb") as f:
-            write_mo(f, catalogue)
-    if "babel" not in app.extensions:
-        app.config["BABEL_TRANSLATION_DIRECTORIES"] = str(folder)
-        Babel(app, locale_selector=lambda: request.accept_languages.best_match(SHIPPED) or "en")
-    else:
-        with app.app_context():
-            get_babel(app).translation_directories.append(str(folder))
-
-
 @pytest.fixture
-def server(live_server_factory, tmp_path):
-    made = live_server_factory()
-    _with_api_catalogues(made.app, tmp_path / "catalogues")
-    return made
+def server(live_server):
+    # The real app: rover_web/i18n's Babel, its locale selector and the catalogues it compiled at
+    # start from translations/ (api.po with messages.po).
+    return live_server
 
 
 def _ask(server, method: str, path: str, lang: str | None, **kwargs) -> requests.Response:
@@ -112,6 +85,16 @@ def test_the_message_follows_the_preferred_language_and_its_weights(server):
     assert japanese == _catalogue("ja")["'%(key)s' is required: send {\"lng\": <degrees east>, \"lat\": <degrees "
                                         "north>}"] % {"key": "lat"}
     assert spanish.startswith("'lat' es obligatorio")
+
+
+def test_the_chosen_language_wins_over_the_browsers(server):
+    # The page's language picker keeps the choice in the cookie rover_web_lang (and, signed in, in
+    # the user's preferences): an API error follows it as the pages do; "auto" is Accept-Language's.
+    path, kwargs = "/api/waypoints", {"json": {"lng": 500, "lat": 0}}
+    chosen = _ask(server, "POST", path, "ja", cookies={"rover_web_lang": "es"}, **kwargs).json()
+    automatic = _ask(server, "POST", path, "ja", cookies={"rover_web_lang": "auto"}, **kwargs).json()
+    assert chosen == {"error": "out_of_range", "message": "'lng' debe estar entre -180 y 180; se recibió 500"}
+    assert automatic["message"] == "'lng' は -180〜180 でなければなりません (受け取った値: 500)"
 
 
 @pytest.mark.parametrize("lang", ["de", "fr-FR, de;q=0.5", "x-klingon", ""])

@@ -18,7 +18,6 @@ MESSAGE_ARG = {
     "error_response": 2,
     "InvalidInput": 0,
     "explain": 0,
-    "N_": 0,
 }
 KEYWORDS = [f"{name}:{index + 1}" for name, index in MESSAGE_ARG.items()]
 
@@ -104,7 +103,7 @@ def problems(root: Path = PACKAGE) -> list[str]:
             arg = node.args[index]
             if isinstance(arg, ast.Constant) and isinstance(arg.value, str):
                 continue
-            if name not in ("explain", "N_") and _carried(arg):
+            if name != "explain" and _carried(arg):
                 continue
             kind = "an f-string" if isinstance(arg, ast.JoinedStr) else type(arg).__name__
             found.append(f"{where}: message is {kind}, not a literal msgid")
