@@ -18,8 +18,8 @@ from rover_web.web.api_messages import explain
 
 class TooManyStreams(Exception):
     def __init__(self, limit: int, message: str | None = None):
-        super().__init__(message or f"{limit} streams are open already (ROVER_WEB_MAX_STREAMS); "
-                                    "close a tab or a camera view")
+        super().__init__(message or explain("%(limit)s streams are open already (ROVER_WEB_MAX_STREAMS); "
+                                            "close a tab or a camera view", limit=limit))
         self.limit = limit
 
 

@@ -30,8 +30,11 @@ class EStopEngaged(Exception):
     """A request that would move the robot while the e-stop is engaged."""
 
     def __init__(self, state: dict):
-        by = f" by {state['by']}" if state.get("by") else ""
-        super().__init__(f"the e-stop is engaged{by}: release it before sending motion")
+        if state.get("by"):
+            super().__init__(explain("the e-stop is engaged by %(name)s: release it before sending motion",
+                                     name=state["by"]))
+        else:
+            super().__init__(explain("the e-stop is engaged: release it before sending motion"))
         self.state = state
 
 

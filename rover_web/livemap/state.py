@@ -70,9 +70,10 @@ class LiveMap:
             cm_per_pixel = geometry.cm_per_pixel
         if isinstance(cm_per_pixel, bool) or not isinstance(cm_per_pixel, (int, float)) \
                 or not math.isfinite(cm_per_pixel) or not MIN_CM_PER_PIXEL <= cm_per_pixel <= MAX_CM_PER_PIXEL:
-            raise ValueError(f"cm_per_pixel must be a number from {MIN_CM_PER_PIXEL:g} to {MAX_CM_PER_PIXEL:g}")
+            raise ValueError(explain("cm_per_pixel must be a number from %(low)s to %(high)s",
+                                     low=format(MIN_CM_PER_PIXEL, "g"), high=format(MAX_CM_PER_PIXEL, "g")))
         if not (math.isfinite(bot_cm_diameter) and bot_cm_diameter > 0):
-            raise ValueError("bot_cm_diameter must be a positive number of centimetres")
+            raise ValueError(explain("bot_cm_diameter must be a positive number of centimetres"))
         self.definition = definition
         self.geometry = geometry
         self.cm_per_pixel = float(cm_per_pixel)
