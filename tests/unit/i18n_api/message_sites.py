@@ -38,6 +38,7 @@ REFUSALS = {
     "_bad": 0,  # ros_admin/parameters.py: a ParameterRefused(400, ...)
     "Refusal": 1,  # panels/state.py: why a control cannot be used now
     "too_many": 0,  # web/http.py: what there were too many of (429)
+    "NoAnswer": 0,  # ros/admin.py, ros/goal_client.py: a ROS server that did not answer in time
 }
 # The same name for another class in these folders (a different signature), and what is not a user's.
 REFUSAL_OVERRIDES = {("FieldError", "rover_web/plot/"): 0, ("FrameError", "rover_web/camera/"): 0,
