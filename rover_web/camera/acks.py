@@ -28,6 +28,7 @@ import time
 from collections import deque
 from collections.abc import Callable
 
+from rover_web.web.api_messages import explain
 from rover_web.web.validate import InvalidInput
 
 # An acknowledged stream whose page has said nothing new for this long while bytes were
@@ -95,7 +96,7 @@ class AckedStream:
                     "'bytes' must be between 0 and %(written)s (the bytes sent so far), got %(value)s",
                     "out_of_range",
                     written=self._written,
-                    value=value if abs(value) < 10**30 else "a larger number",
+                    value=value if abs(value) < 10**30 else explain("a larger number"),
                 )
             if value <= self._acked:
                 return False
