@@ -23,6 +23,8 @@ from dataclasses import dataclass
 from argon2 import PasswordHasher
 from argon2.exceptions import InvalidHashError, VerificationError
 
+from rover_web.web.api_messages import explain
+
 from .throttle import HashGate, HashingBusy
 
 ROLES = ("viewer", "operator", "admin")
@@ -90,20 +92,27 @@ class User:
 
 def check_name(name: str) -> str:
     if not isinstance(name, str) or not NAME_PATTERN.match(name):
-        raise AccountError("a user name is 1-40 letters, digits, '_', '.', '@' or '-', starting with a letter "
-                           "or digit", "bad_name")
+        raise AccountError(explain("a user name is 1-40 letters, digits, '_', '.', '@' or '-', starting with a "
+                                   "letter or digit"), "bad_name")
     return name
 
 
 def check_role(role: str) -> str:
     if role not in ROLES:
-        raise AccountError(f"role must be one of {', '.join(ROLES)}", "bad_role")
+        raise AccountError(explain("role must be one of %(roles)s", roles=', '.join(ROLES)), "bad_role")
     return role
 
 
 def check_password(password: str) -> str:
     if not isinstance(password, str) or not MIN_PASSWORD_LEN <= len(password) <= MAX_PASSWORD_LEN:
-        raise AccountError(f"a password is {MIN_PASSWORD_LEN} to {MAX_PASSWORD_LEN} characters", "bad_password")
+        raise AccountError(
+            explain(
+                "a password is %(min_password_len)s to %(max_password_len)s characters",
+                min_password_len=MIN_PASSWORD_LEN,
+                max_password_len=MAX_PASSWORD_LEN,
+            ),
+            "bad_password",
+        )
     return password
 
 
@@ -130,7 +139,7 @@ class Accounts:
                 conn.execute("INSERT INTO auth_users (name, role, password_hash, created_at) VALUES (?, ?, ?, ?)",
                              (name, role, password_hash, time.time()))
         except sqlite3.IntegrityError:
-            raise AccountError(f"user {name!r} exists already", "user_exists") from None
+            raise AccountError(explain("user %(name)s exists already", name=repr(name)), "user_exists") from None
         return User(name, role)
 
     def users(self) -> list[dict]:
@@ -151,7 +160,7 @@ class Accounts:
         check_role(role)
         with self._db.transaction() as conn:
             if conn.execute("UPDATE auth_users SET role = ? WHERE name = ?", (role, name)).rowcount == 0:
-                raise AccountError(f"no user {name!r}", "no_such_user")
+                raise AccountError(explain("no user %(name)s", name=repr(name)), "no_such_user")
         return User(name, role)
 
     def set_password(self, name: str, password: str) -> None:
@@ -160,13 +169,13 @@ class Accounts:
         with self._db.transaction() as conn:
             if conn.execute("UPDATE auth_users SET password_hash = ? WHERE name = ?",
                             (password_hash, name)).rowcount == 0:
-                raise AccountError(f"no user {name!r}", "no_such_user")
+                raise AccountError(explain("no user %(name)s", name=repr(name)), "no_such_user")
 
     def remove_user(self, name: str) -> None:
         """Removes the user and, with them, their tokens (ON DELETE CASCADE)."""
         with self._db.transaction() as conn:
             if conn.execute("DELETE FROM auth_users WHERE name = ?", (name,)).rowcount == 0:
-                raise AccountError(f"no user {name!r}", "no_such_user")
+                raise AccountError(explain("no user %(name)s", name=repr(name)), "no_such_user")
 
     def authenticate(self, name: str, password: str) -> User | None:
         """The user, if the password is theirs; None otherwise (same time either way).
@@ -204,11 +213,11 @@ class Accounts:
     def create_token(self, user_name: str, label: str = "") -> tuple[int, str]:
         """A new token for the user: (its id, the token). The token is not stored and cannot be shown again."""
         if len(label) > 80:
-            raise AccountError("a token label is at most 80 characters", "bad_label")
+            raise AccountError(explain("a token label is at most 80 characters"), "bad_label")
         token = TOKEN_PREFIX + secrets.token_urlsafe(32)
         with self._db.transaction() as conn:
             if conn.execute("SELECT 1 FROM auth_users WHERE name = ?", (user_name,)).fetchone() is None:
-                raise AccountError(f"no user {user_name!r}", "no_such_user")
+                raise AccountError(explain("no user %(user_name)s", user_name=repr(user_name)), "no_such_user")
             cursor = conn.execute(
                 "INSERT INTO auth_tokens (user_name, token_sha256, label, created_at) VALUES (?, ?, ?, ?)",
                 (user_name, token_digest(token), label, time.time()))
@@ -221,11 +230,11 @@ class Accounts:
 
     def revoke_token(self, token_id: int) -> None:
         if not 0 <= token_id <= SQLITE_MAX_INT:  # SQLite cannot even compare a larger integer
-            raise AccountError(f"no token with id {str(token_id)[:30]}", "no_such_token")
+            raise AccountError(explain("no token with id %(token_id)s", token_id=str(token_id)[:30]), "no_such_token")
         with self._db.transaction() as conn:
             row = conn.execute("SELECT revoked_at FROM auth_tokens WHERE id = ?", (token_id,)).fetchone()
             if row is None:
-                raise AccountError(f"no token with id {token_id}", "no_such_token")
+                raise AccountError(explain("no token with id %(token_id)s", token_id=token_id), "no_such_token")
             if row["revoked_at"] is None:
                 conn.execute("UPDATE auth_tokens SET revoked_at = ? WHERE id = ?", (time.time(), token_id))
 

@@ -10,6 +10,7 @@ from flask import Blueprint, g, jsonify, make_response, redirect, render_templat
 from flask_login import current_user, login_user, logout_user
 
 from rover_web.core.state import current_feature, current_rover
+from rover_web.web.api_messages import Text, explain, text_of
 from rover_web.web.http import ApiError, accepts_form, error_response, json_body, wants_json
 from rover_web.web.validate import InvalidInput, only_keys, text
 
@@ -50,8 +51,9 @@ def check_access():
         return None
     if not current_user.is_authenticated and exposure is not None and auth.accounts.count() == 0:
         return error_response(403, "sign_in_needed",
-                              f"sign-in is off only for requests made on this machine, and {exposure}; "
-                              f"set ROVER_WEB_AUTH=required and add a user with `{ADD_USER_HINT}`")
+                              "sign-in is off only for requests made on this machine, and %(exposure)s; set "
+                              "ROVER_WEB_AUTH=required and add a user with `%(add_user_hint)s`",
+                              exposure=exposure, add_user_hint=ADD_USER_HINT)
     if not current_user.is_authenticated:
         if request.method == "GET" and not wants_json(request):
             # With the script root: sign-in at /robots/drone/login returns to the drone's page.
@@ -67,13 +69,15 @@ def check_access():
 
 def _forbidden(needed: str):
     return error_response(403, "forbidden",
-                          f"this needs the {needed} role; {current_user.name} is a {current_user.role}")
+                          "this needs the %(needed)s role; %(name)s is a %(role)s",
+                          needed=needed, name=current_user.name, role=current_user.role)
 
 
 def require_role(role: str) -> None:
     """For views whose rule depends on the request body (releasing the e-stop needs an operator)."""
     if _service().sign_in_on() and not role_allows(current_user.role, role):
-        raise ApiError(403, "forbidden", f"this needs the {role} role; {current_user.name} is a {current_user.role}")
+        raise ApiError(403, "forbidden", "this needs the %(role)s role; %(name)s is a %(role2)s",
+                       role=role, name=current_user.name, role2=current_user.role)
 
 
 MAX_NEXT_LEN = 2000
@@ -122,23 +126,26 @@ def login():
     username, password = fields.get("username"), fields.get("password")
     next_path = _safe_next(fields.get("next") if not as_json else None)
     if not isinstance(username, str) or not isinstance(password, str) or not username or not password:
-        return _login_refused(as_json, 400, "missing_field", "enter a user name and a password", "", next_path)
+        return _login_refused(as_json, 400, "missing_field", explain("enter a user name and a password"), "", next_path)
     username = username.strip()[:80]
     address = request.remote_addr or "unknown"
     wait_s, why = auth.throttle.admit(username, address)
     if wait_s > 0:
-        return _login_refused(as_json, 429, "too_many_attempts", f"{why}: try again in {wait_s:.0f} s",
+        return _login_refused(as_json, 429, "too_many_attempts",
+                              explain("%(why)s: try again in %(seconds)s s", why=why, seconds=format(wait_s, ".0f")),
                               username, next_path, retry_after_s=wait_s)
     try:
         user = auth.accounts.authenticate(username, password)
     except HashingBusy:
         # Refused before any hash is computed: the server's memory is bounded, not the queue's wait.
-        return _login_refused(as_json, 503, "busy", "the server is checking other sign-ins: try again in a second",
+        return _login_refused(as_json, 503, "busy",
+                              explain("the server is checking other sign-ins: try again in a second"),
                               username, next_path, retry_after_s=1)
     if user is None:
         auth.throttle.failed(username, address)
         _audit("auth.sign_in_refused", username, f"wrong password or user name for {username!r}")
-        return _login_refused(as_json, 401, "bad_credentials", "wrong user name or password", username, next_path)
+        return _login_refused(as_json, 401, "bad_credentials", explain("wrong user name or password"), username,
+                              next_path)
     auth.throttle.succeeded(username, address)
     _start_session(auth, user.name)
     _audit("auth.sign_in", user.name, f"{user.name} signed in ({user.role})")
@@ -147,12 +154,12 @@ def login():
     return redirect(next_path, 303)
 
 
-def _login_refused(as_json: bool, status: int, code: str, message: str, username: str, next_path: str,
+def _login_refused(as_json: bool, status: int, code: str, message_text: Text, username: str, next_path: str,
                    retry_after_s: float | None = None):
     if as_json:
-        response = error_response(status, code, message)
+        response = error_response(status, code, message_text)
     else:
-        html = _login_page(next_path, message, username)
+        html = _login_page(next_path, message_text.translated(), username)
         response = make_response(html, status, {"Content-Type": "text/html; charset=utf-8"})
     if retry_after_s is not None:
         response.headers["Retry-After"] = str(max(1, int(retry_after_s + 0.999)))
@@ -244,12 +251,12 @@ def _cut(sock) -> None:
 @bp.errorhandler(AccountError)
 def account_error(exc: AccountError):
     status = 404 if exc.code.startswith("no_such") else 409 if exc.code == "user_exists" else 400
-    return error_response(status, exc.code, str(exc))
+    return error_response(status, exc.code, text_of(exc))
 
 
 @bp.errorhandler(InvalidInput)
 def invalid_input(exc: InvalidInput):
-    return error_response(400, exc.code, str(exc))
+    return error_response(400, exc.code, text_of(exc))
 
 
 @bp.get("/api/users")
@@ -277,7 +284,7 @@ def admin_update_user(name: str):
     role = text(body, "role", max_len=20, default=None)
     password = text(body, "password", max_len=1024, default=None)
     if accounts.get(name) is None:
-        raise AccountError(f"no user {name!r}", "no_such_user")
+        raise AccountError(explain("no user %(name)s", name=repr(name)), "no_such_user")
     # Both checked before either is written: a bad password must not leave a changed role.
     if role is not None:
         check_role(role)

@@ -11,6 +11,7 @@ from pathlib import Path
 from flask import g
 
 from rover_web.config import ConfigError
+from rover_web.web.api_messages import explain
 
 from .accounts import ARGON2_MEMORY_KIB, ARGON2_TIME_COST, DEFAULT_MAX_HASHING, Accounts, password_hasher
 from .policy import exposed_host, forwarded_header, is_loopback, sign_in_required
@@ -52,10 +53,10 @@ class AuthService:
             return None
         header = forwarded_header(req.headers)
         if header:
-            return f"it came through a proxy ({header})"
+            return explain("it came through a proxy (%(header)s)", header=header)
         host = exposed_host(req.host)
         if host:
-            return f"it asked for the host {host[:80]!r}"
+            return explain("it asked for the host %(host)s", host=repr(host[:80]))
         return None
 
     def sign_in_on(self) -> bool:

@@ -24,6 +24,7 @@ from contextlib import contextmanager
 from typing import TypeVar
 
 from rover_web.core.rate_limit import RateLimit
+from rover_web.web.api_messages import Text, explain
 
 MAX_TRACKED_KEYS = 10_000  # addresses and names are attacker-chosen: the tables must not grow without bound
 FREE_FAILURES_PER_ADDRESS = 10  # failures (any names) from one address before it waits at all
@@ -60,7 +61,7 @@ class HashGate:
         if not self._slots.acquire(blocking=wait):
             with self._lock:
                 self.refused += 1
-            raise HashingBusy(f"{self.limit} sign-ins are being checked already")
+            raise HashingBusy(explain("%(limit)s sign-ins are being checked already", limit=self.limit))
         with self._lock:
             self.active += 1
             self.peak = max(self.peak, self.active)
@@ -134,19 +135,19 @@ class SignInThrottle:
         self._by_name = _Backoff(FREE_FAILURES_PER_NAME, clock)
         self._lock = threading.Lock()
 
-    def admit(self, name: str, address: str) -> tuple[float, str]:
+    def admit(self, name: str, address: str) -> tuple[float, Text | str]:
         """(0, "") and the attempt is counted, or (seconds to wait, why) and nothing is counted."""
         now = self._clock()
         with self._lock:
             wait = self._by_address.wait_s(address, now)
             if wait > 0:
-                return wait, "too many failed sign-ins from this address"
+                return wait, explain("too many failed sign-ins from this address")
             wait = self._by_name.wait_s((name, address), now)
             if wait > 0:
-                return wait, f"too many failed sign-ins for {name!r} from this address"
+                return wait, explain("too many failed sign-ins for %(name)s from this address", name=repr(name))
         wait = self._attempts.hit(address)
         if wait > 0:
-            return wait, "too many sign-in attempts from this address"
+            return wait, explain("too many sign-in attempts from this address")
         return 0.0, ""
 
     def failed(self, name: str, address: str) -> None:

@@ -19,6 +19,7 @@ import tempfile
 from pathlib import Path
 
 from rover_web.config import repo_path
+from rover_web.web.api_messages import explain, text_of
 from rover_web.web.validate import InvalidInput, loads_strict
 
 log = logging.getLogger(__name__)
@@ -44,20 +45,22 @@ def _positions(coords, depth: int, where: str, counter: list[int]):
     """Every [lng, lat] of a geometry's nested coordinates, checked."""
     if depth == 0:
         if not isinstance(coords, list) or len(coords) < 2 or len(coords) > 3:
-            raise BadFeatures(f"{where}: a position must be [lng, lat] or [lng, lat, alt]")
+            raise BadFeatures(explain("%(where)s: a position must be [lng, lat] or [lng, lat, alt]", where=where))
         if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in coords):
-            raise BadFeatures(f"{where}: a position must hold numbers")
+            raise BadFeatures(explain("%(where)s: a position must hold numbers", where=where))
         lng, lat = float(coords[0]), float(coords[1])
         if not (math.isfinite(lng) and math.isfinite(lat) and -180 <= lng <= 180 and -90 <= lat <= 90):
-            raise BadFeatures(f"{where}: [{coords[0]}, {coords[1]}] is not a longitude in [-180, 180] and a "
-                              "latitude in [-90, 90]")
+            raise BadFeatures(explain("%(where)s: [%(coords)s, %(coords2)s] is not a longitude in [-180, 180] and "
+                                      "a latitude in [-90, 90]",
+                                      where=where, coords=coords[0], coords2=coords[1]))
         counter[0] += 1
         if counter[0] > MAX_POSITIONS:
-            raise BadFeatures(f"more than {MAX_POSITIONS:,} positions: simplify the file first")
+            raise BadFeatures(explain("more than %(max_positions)s positions: simplify the file first",
+                                      max_positions=format(MAX_POSITIONS, ",")))
         yield lng, lat
         return
     if not isinstance(coords, list):
-        raise BadFeatures(f"{where}: coordinates must be arrays")
+        raise BadFeatures(explain("%(where)s: coordinates must be arrays", where=where))
     for i, inner in enumerate(coords):
         yield from _positions(inner, depth - 1, f"{where}[{i}]", counter)
 
@@ -68,30 +71,34 @@ DEPTH = {"Point": 0, "MultiPoint": 1, "LineString": 1, "MultiLineString": 2, "Po
 def check(collection) -> dict:
     """The collection, its bounds added (bbox), if it is a drawable basemap; BadFeatures otherwise."""
     if not isinstance(collection, dict) or collection.get("type") != "FeatureCollection":
-        raise BadFeatures('a basemap must be a GeoJSON FeatureCollection ({"type": "FeatureCollection", ...})')
+        raise BadFeatures(explain("a basemap must be a GeoJSON FeatureCollection ({\"type\": \"FeatureCollection\", "
+                                  "...})"))
     features = collection.get("features")
     if not isinstance(features, list) or not features:
-        raise BadFeatures("'features' must be a non-empty array")
+        raise BadFeatures(explain("'features' must be a non-empty array"))
     if len(features) > MAX_FEATURES:
-        raise BadFeatures(f"{len(features):,} features; at most {MAX_FEATURES:,}")
+        raise BadFeatures(explain("%(count)s features; at most %(max_features)s",
+                                  count=format(len(features), ","), max_features=format(MAX_FEATURES, ",")))
     for key in ("name", "attribution", "license"):
         if key in collection and not (isinstance(collection[key], str) and len(collection[key]) <= 500):
-            raise BadFeatures(f"'{key}' must be a string of at most 500 characters")
+            raise BadFeatures(explain("'%(key)s' must be a string of at most 500 characters", key=key))
     counter = [0]
     west = south = math.inf
     east = north = -math.inf
     for i, feature in enumerate(features):
         where = f"features[{i}]"
         if not isinstance(feature, dict) or feature.get("type") != "Feature":
-            raise BadFeatures(f"{where}: not a GeoJSON Feature")
+            raise BadFeatures(explain("%(where)s: not a GeoJSON Feature", where=where))
         props = feature.get("properties")
         kind = props.get("kind") if isinstance(props, dict) else None
         if kind not in KINDS:
-            raise BadFeatures(f"{where}.properties.kind must be one of {', '.join(KINDS)}; got {kind!r}")
+            raise BadFeatures(explain("%(where)s.properties.kind must be one of %(kinds)s; got %(kind)s",
+                                      where=where, kinds=', '.join(KINDS), kind=repr(kind)))
         geometry = feature.get("geometry")
         gtype = geometry.get("type") if isinstance(geometry, dict) else None
         if gtype not in GEOMETRIES:
-            raise BadFeatures(f"{where}.geometry.type must be one of {', '.join(GEOMETRIES)}; got {gtype!r}")
+            raise BadFeatures(explain("%(where)s.geometry.type must be one of %(geometries)s; got %(gtype)s",
+                                      where=where, geometries=', '.join(GEOMETRIES), gtype=repr(gtype)))
         for lng, lat in _positions(geometry.get("coordinates"), DEPTH[gtype], f"{where}.geometry.coordinates",
                                    counter):
             west, east, south, north = min(west, lng), max(east, lng), min(south, lat), max(north, lat)
@@ -100,15 +107,16 @@ def check(collection) -> dict:
 
 def parse(data: bytes, where: str) -> dict:
     if len(data) > MAX_FILE_BYTES:
-        raise BadFeatures(f"{where}: larger than {MAX_FILE_BYTES // (1024 * 1024)} MB")
+        raise BadFeatures(explain("%(where)s: larger than %(value)s MB",
+                                  where=where, value=MAX_FILE_BYTES // (1024 * 1024)))
     try:
         collection = loads_strict(data)
     except InvalidInput as exc:
-        raise BadFeatures(f"{where}: {exc}") from None
+        raise BadFeatures(explain("%(where)s: %(why)s", where=where, why=text_of(exc))) from None
     try:
         return check(collection)
     except BadFeatures as exc:
-        raise BadFeatures(f"{where}: {exc}") from None
+        raise BadFeatures(explain("%(where)s: %(why)s", where=where, why=text_of(exc))) from None
 
 
 @functools.lru_cache(maxsize=16)
@@ -157,7 +165,8 @@ class FeatureFolder:
     def write(self, name: str, collection: dict, *, replace: bool = False) -> Path:
         """Store a checked collection as <name>.geojson, atomically; FileExistsError unless replace."""
         if not NAME.match(name):
-            raise BadFeatures(f"{name!r} is not a basemap name: letters, digits, '_' and '-', at most 64")
+            raise BadFeatures(explain("%(name)s is not a basemap name: letters, digits, '_' and '-', at most 64",
+                                      name=repr(name)))
         self.root.mkdir(parents=True, exist_ok=True)
         path = self.root / f"{name}{SUFFIX}"
         if path.exists() and not replace:

@@ -16,6 +16,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from rover_web.web.api_messages import explain, text_of
+
 from .features import NAME, BadFeatures, FeatureFolder, parse
 from .tile_store import MAX_ZOOM, MBTiles, TileStoreError, image_format, valid_tile
 
@@ -43,16 +45,19 @@ def _tile_lat(y: int, z: int) -> float:
 
 def _open(path: Path) -> sqlite3.Connection:
     if not path.is_file():
-        raise ImportRefused(f"{path}: no such file")
+        raise ImportRefused(explain("%(path)s: no such file", path=path))
     try:
         conn = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True)
         names = {row[0] for row in conn.execute("SELECT name FROM sqlite_master WHERE type IN ('table', 'view')")}
     except sqlite3.DatabaseError as exc:
-        raise ImportRefused(f"{path}: not an MBTiles file (SQLite says: {exc})") from None
+        raise ImportRefused(
+            explain("%(path)s: not an MBTiles file (SQLite says: %(why)s)", path=path, why=text_of(exc))
+        ) from None
     if "tiles" not in names:
         conn.close()
-        raise ImportRefused(f"{path}: not an MBTiles file: it has no 'tiles' table (MBTiles 1.3: metadata(name, "
-                            "value) and tiles(zoom_level, tile_column, tile_row, tile_data))")
+        raise ImportRefused(explain("%(path)s: not an MBTiles file: it has no 'tiles' table (MBTiles 1.3: "
+                                    "metadata(name, value) and tiles(zoom_level, tile_column, tile_row, tile_data))",
+                                    path=path))
     return conn
 
 
@@ -60,14 +65,14 @@ def _rows(conn: sqlite3.Connection, path: Path):
     try:
         yield from conn.execute("SELECT zoom_level, tile_column, tile_row, tile_data FROM tiles")
     except sqlite3.DatabaseError as exc:
-        raise ImportRefused(f"{path}: cannot read its tiles: {exc}") from None
+        raise ImportRefused(explain("%(path)s: cannot read its tiles: %(why)s", path=path, why=text_of(exc))) from None
 
 
 def import_mbtiles(path: Path, store, *, force: bool = False, attribution: str = "",
                    report: Callable[[str], None] = lambda line: None) -> ImportResult:
     """Copy every tile of the MBTiles file `path` into `store`; ImportRefused (nothing written) if any is bad."""
     if isinstance(store, MBTiles) and store.path.resolve() == path.resolve():
-        raise ImportRefused(f"{path} is the store itself")
+        raise ImportRefused(explain("%(path)s is the store itself", path=path))
     conn = _open(path)
     try:
         try:
@@ -75,8 +80,10 @@ def import_mbtiles(path: Path, store, *, force: bool = False, attribution: str =
         except sqlite3.DatabaseError:
             meta = {}
         if meta.get("format", "").lower() in VECTOR_FORMATS:
-            raise ImportRefused(f"{path}: holds vector tiles (format {meta['format']}); the map draws raster tiles "
-                                "(PNG, JPEG, WebP): render them to raster first, or import the data as GeoJSON")
+            raise ImportRefused(explain("%(path)s: holds vector tiles (format %(meta)s); the map draws raster "
+                                        "tiles (PNG, JPEG, WebP): render them to raster first, or import the data "
+                                        "as GeoJSON",
+                                        path=path, meta=meta['format']))
         zooms: dict[int, list[int]] = {}  # z -> [x0, x1, y0, y1] in XYZ
         formats: set[str] = set()
         count = 0
@@ -85,17 +92,17 @@ def import_mbtiles(path: Path, store, *, force: bool = False, attribution: str =
             on_grid = all(isinstance(v, int) for v in (z, x, row)) and 0 <= z <= MAX_ZOOM \
                 and valid_tile(z, x, (1 << z) - 1 - row)
             if not on_grid:
-                raise ImportRefused(f"{where}: not on the tile grid")
+                raise ImportRefused(explain("%(where)s: not on the tile grid", where=where))
             fmt = image_format(bytes(data)) if isinstance(data, (bytes, memoryview)) else None
             if fmt is None:
-                raise ImportRefused(f"{where}: not a PNG, JPEG or WebP image")
+                raise ImportRefused(explain("%(where)s: not a PNG, JPEG or WebP image", where=where))
             formats.add(fmt)
             y = (1 << z) - 1 - row
             box = zooms.setdefault(z, [x, x, y, y])
             box[:] = [min(box[0], x), max(box[1], x), min(box[2], y), max(box[3], y)]
             count += 1
         if not count:
-            raise ImportRefused(f"{path}: has no tiles")
+            raise ImportRefused(explain("%(path)s: has no tiles", path=path))
         result = ImportResult()
         is_mbtiles = isinstance(store, MBTiles)
         if is_mbtiles:
@@ -143,16 +150,17 @@ def import_geojson(path: Path, folder: FeatureFolder, *, name: str | None = None
                    force: bool = False) -> Path:
     """Check `path` as a drawn basemap and store it in `folder`; ImportRefused if it is not one."""
     if not path.is_file():
-        raise ImportRefused(f"{path}: no such file")
+        raise ImportRefused(explain("%(path)s: no such file", path=path))
     if name is None:
         name = "".join(c if c.isalnum() or c in "_-" else "-" for c in path.stem).strip("-_")[:64] or "imported"
     if not NAME.match(name):
-        raise ImportRefused(f"--name {name!r}: letters, digits, '_' and '-' only, at most 64, starting with a "
-                            "letter or digit")
+        raise ImportRefused(explain("--name %(name)s: letters, digits, '_' and '-' only, at most 64, starting with "
+                                    "a letter or digit",
+                                    name=repr(name)))
     try:
         collection = parse(path.read_bytes(), str(path))
         if attribution:
             collection = {**collection, "attribution": attribution[:500]}
         return folder.write(name, collection, replace=force)
     except (BadFeatures, FileExistsError, OSError, TileStoreError) as exc:
-        raise ImportRefused(str(exc)) from None
+        raise ImportRefused(text_of(exc)) from None

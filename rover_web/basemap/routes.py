@@ -39,7 +39,7 @@ def features(name: str):
     found = feature_folder(current_app.config)
     collection = found.get(name) if found is not None else None
     if collection is None:
-        return error_response(404, "unknown_basemap", f"no drawn basemap named {name[:64]!r}")
+        return error_response(404, "unknown_basemap", "no drawn basemap named %(name)s", name=repr(name[:64]))
     response = jsonify(collection)
     response.mimetype = "application/geo+json"
     response.headers["Cache-Control"] = "no-cache"

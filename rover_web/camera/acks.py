@@ -28,6 +28,7 @@ import time
 from collections import deque
 from collections.abc import Callable
 
+from rover_web.web.api_messages import explain
 from rover_web.web.validate import InvalidInput
 
 # An acknowledged stream whose page has said nothing new for this long while bytes were
@@ -91,8 +92,12 @@ class AckedStream:
                                "bad_type")
         with self._lock:
             if not 0 <= value <= self._written:
-                raise InvalidInput(f"'bytes' must be between 0 and {self._written} (the bytes sent so far), "
-                                   f"got {value if abs(value) < 10**30 else 'a larger number'}", "out_of_range")
+                raise InvalidInput(
+                    "'bytes' must be between 0 and %(written)s (the bytes sent so far), got %(value)s",
+                    "out_of_range",
+                    written=self._written,
+                    value=value if abs(value) < 10**30 else explain("a larger number"),
+                )
             if value <= self._acked:
                 return False
             now = self._clock()

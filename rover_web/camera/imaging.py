@@ -28,6 +28,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from rover_web.web.api_messages import Text, as_text, explain, text_of
+
 if TYPE_CHECKING:
     from PIL import Image, ImageFont
 
@@ -86,27 +88,43 @@ class Jpeg:
     passthrough: bool = False  # the publisher's own JPEG bytes, not re-encoded
     error: str | None = None  # set for an error frame
     error_code: str | None = None
+    error_text: Text | None = None  # the error as a Text, for an answer in the request's language
     encode_s: float = 0.0
 
 
 def image_to_array(image: RawImage) -> np.ndarray:
     """Pixels as an H×W×3 (RGB) or H×W (grey) uint8 array; a view of `data` where possible."""
     if image.encoding not in ENCODINGS:
-        raise FrameError(f"image encoding {image.encoding!r} is not supported; supported: {', '.join(SUPPORTED)}",
+        raise FrameError(explain("image encoding %(encoding)s is not supported; supported: %(supported)s",
+                                 encoding=repr(image.encoding), supported=', '.join(SUPPORTED)),
                          "unsupported_encoding")
     bpp, _ = ENCODINGS[image.encoding]
     width, height, step = int(image.width), int(image.height), int(image.step)
     if width <= 0 or height <= 0:
-        raise FrameError(f"image is {width}×{height}: nothing to show", "empty_image")
+        raise FrameError(
+            explain("image is %(width)s×%(height)s: nothing to show", width=width, height=height), "empty_image"
+        )
     if width * height > MAX_PIXELS:
-        raise FrameError(f"image is {width}×{height}, more than {MAX_PIXELS} pixels", "image_too_large")
+        raise FrameError(explain("image is %(width)s×%(height)s, more than %(max_pixels)s pixels",
+                                 width=width, height=height, max_pixels=MAX_PIXELS), "image_too_large")
     if step < width * bpp:
-        raise FrameError(f"step {step} is less than width × {bpp} bytes ({width * bpp}) for {image.encoding}",
+        raise FrameError(explain("step %(step)s is less than width × %(bpp)s bytes (%(value)s) for %(encoding)s",
+                                 step=step, bpp=bpp, value=width * bpp, encoding=image.encoding),
                          "bad_step")
     buffer = np.frombuffer(image.data, dtype=np.uint8)
     if buffer.size < step * (height - 1) + width * bpp:
-        raise FrameError(f"image data has {buffer.size} bytes; {width}×{height} {image.encoding} with step {step} "
-                         f"needs {step * height}", "short_data")
+        raise FrameError(
+            explain(
+                "image data has %(size)s bytes; %(width)s×%(height)s %(encoding)s with step %(step)s needs %(value)s",
+                size=buffer.size,
+                width=width,
+                height=height,
+                encoding=image.encoding,
+                step=step,
+                value=step * height,
+            ),
+            "short_data",
+        )
     if buffer.size < step * height:  # some drivers leave out the last row's padding
         buffer = np.concatenate([buffer, np.zeros(step * height - buffer.size, np.uint8)])
     rows = buffer[:step * height].reshape(height, step)[:, :width * bpp]  # drop row padding
@@ -193,7 +211,7 @@ IMAGE_FORMATS = ("JPEG", "PNG")
 
 def check_compressed_format(frame: CompressedFrame) -> None:
     if "compresseddepth" in frame.format.lower():
-        raise FrameError("compressedDepth images are not supported; view the raw depth topic instead",
+        raise FrameError(explain("compressedDepth images are not supported; view the raw depth topic instead"),
                          "unsupported_encoding")
 
 
@@ -211,7 +229,8 @@ def decode_compressed(frame: CompressedFrame, data: bytes | None = None,
         # Ghostscript), TIFF, ICO and dozens more from bytes any publisher on the graph chooses.
         picture = Image.open(io.BytesIO(data), formats=IMAGE_FORMATS)
         if picture.width * picture.height > MAX_PIXELS:
-            raise FrameError(f"image is {picture.width}×{picture.height}, more than {MAX_PIXELS} pixels",
+            raise FrameError(explain("image is %(width)s×%(height)s, more than %(max_pixels)s pixels",
+                                     width=picture.width, height=picture.height, max_pixels=MAX_PIXELS),
                              "image_too_large")
         if picture.format == "JPEG" and output_size_of is not None:
             picture.draft("RGB", output_size_of(picture.width, picture.height))
@@ -219,7 +238,8 @@ def decode_compressed(frame: CompressedFrame, data: bytes | None = None,
     except FrameError:
         raise
     except Exception as exc:  # Pillow raises many types for bad data; all mean "cannot decode"
-        raise FrameError(f"cannot decode the {frame.format or 'compressed'} image: {exc}", "bad_image") from None
+        raise FrameError(explain("cannot decode the %(value)s image: %(why)s",
+                                 value=frame.format or 'compressed', why=text_of(exc)), "bad_image") from None
     if picture.mode in ("I;16", "I;16B", "I;16L", "I", "F"):
         values = np.asarray(picture)
         valid = np.isfinite(values) & (values != 0) if values.dtype.kind == "f" else values > 0
@@ -269,7 +289,7 @@ def font(size: int):
     return _FONT_CACHE[size]
 
 
-def error_frame(message: str, code: str, width: int | None = None, height: int | None = None,
+def error_frame(message: str | Text, code: str, width: int | None = None, height: int | None = None,
                 stamp: float = 0.0, max_pixels: int | None = None) -> Jpeg:
     """A dark JPEG with the reason written on it, for a stream that has already started."""
     from PIL import Image, ImageDraw
@@ -278,7 +298,8 @@ def error_frame(message: str, code: str, width: int | None = None, height: int |
     picture = Image.new("RGB", size, (40, 12, 12))
     draw = ImageDraw.Draw(picture)
     text_size = max(10, min(22, size[0] // 32))
-    words, lines, line = message.split(), [], ""
+    # Written on the picture in English: one frame goes to every viewer, whatever their language.
+    words, lines, line = str(message).split(), [], ""
     per_line = max(10, size[0] // (text_size * 6 // 10))
     for word in words:
         if line and len(line) + 1 + len(word) > per_line:
@@ -292,7 +313,8 @@ def error_frame(message: str, code: str, width: int | None = None, height: int |
         draw.text((10, 10 + (i + 2) * (text_size + 4)), text, fill=(240, 230, 230), font=font(text_size))
     out = io.BytesIO()
     picture.save(out, "JPEG", quality=80)
-    return Jpeg(out.getvalue(), size[0], size[1], stamp, error=message, error_code=code)
+    return Jpeg(out.getvalue(), size[0], size[1], stamp, error=str(message), error_code=code,
+                error_text=as_text(message, {}))
 
 
 def encode_frame(frame: RawImage | CompressedFrame, quality: int, width: int | None = None,
@@ -303,4 +325,4 @@ def encode_frame(frame: RawImage | CompressedFrame, quality: int, width: int | N
             return encode_compressed(frame, quality, width, height, max_pixels)
         return encode_raw(frame, quality, width, height, max_pixels)
     except FrameError as exc:
-        return error_frame(str(exc), exc.code, width, height, getattr(frame, "stamp", 0.0), max_pixels)
+        return error_frame(text_of(exc), exc.code, width, height, getattr(frame, "stamp", 0.0), max_pixels)

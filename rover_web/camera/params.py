@@ -21,11 +21,13 @@ def _int_arg(args: Mapping[str, str], name: str, low: int, high: int, *, origina
     try:
         value = int(text, 10)
     except ValueError:
-        raise InvalidInput(f"'{name}' must be a whole number, got {text[:20]!r}", "bad_type") from None
+        raise InvalidInput("'%(name)s' must be a whole number, got %(text)s", "bad_type",
+                           name=name, text=repr(text[:20])) from None
     if original_ok and value in (0, -1):  # web_video_server's "keep the camera's size"
         return None
     if not low <= value <= high:
-        raise InvalidInput(f"'{name}' must be between {low} and {high}, got {value}", "out_of_range")
+        raise InvalidInput("'%(name)s' must be between %(low)s and %(high)s, got %(value)s", "out_of_range",
+                           name=name, low=low, high=high, value=value)
     return value
 
 
@@ -36,18 +38,25 @@ def parse_stream_args(args: Mapping[str, str], *, max_dimension: int, default_qu
     width = _int_arg(args, "width", 1, max_dimension, original_ok=True)
     height = _int_arg(args, "height", 1, max_dimension, original_ok=True)
     if max_pixels and width and height and width * height > max_pixels:
-        raise InvalidInput(f"{width}×{height} is more than {max_pixels} pixels (ROVER_WEB_CAMERA_MAX_OUTPUT_PIXELS); "
-                           f"ask for a smaller size, or one side only", "out_of_range")
+        raise InvalidInput(
+            "%(width)s×%(height)s is more than %(max_pixels)s pixels "
+            "(ROVER_WEB_CAMERA_MAX_OUTPUT_PIXELS); ask for a smaller size, or one side only",
+            "out_of_range",
+            width=width,
+            height=height,
+            max_pixels=max_pixels,
+        )
     quality = _int_arg(args, "quality", 1, 100)
     qos = args.get("qos_profile") or None
     if qos is not None and qos not in QOS_PROFILES:
-        raise InvalidInput(f"'qos_profile' must be one of {', '.join(QOS_PROFILES)}; got {qos[:40]!r}", "bad_value")
+        raise InvalidInput("'qos_profile' must be one of %(qos_profiles)s; got %(qos)s", "bad_value",
+                           qos_profiles=', '.join(QOS_PROFILES), qos=repr(qos[:40]))
     stream_type = args.get("type")
     msg_type = args.get("msg_type") or None
     if stream_type and stream_type not in STREAM_TYPES:
         if "/" not in stream_type:
-            raise InvalidInput(f"stream type {stream_type[:40]!r} is not supported; this server streams mjpeg",
-                               "unsupported_stream_type")
+            raise InvalidInput("stream type %(stream_type)s is not supported; this server streams mjpeg",
+                               "unsupported_stream_type", stream_type=repr(stream_type[:40]))
         msg_type = msg_type or stream_type  # type=sensor_msgs/msg/Image works too
     return {"topic": topic, "width": width, "height": height,
             "quality": default_quality if quality is None else quality, "qos": qos, "msg_type": msg_type}
@@ -69,6 +78,6 @@ def wants_acks(args: Mapping[str, str]) -> bool:
     if value is None or value in ("", "0"):
         return False
     if value != "1":
-        raise InvalidInput(f"'ack' must be 1 (the page acknowledges what it receives) or 0; got {value[:20]!r}",
-                           "bad_value")
+        raise InvalidInput("'ack' must be 1 (the page acknowledges what it receives) or 0; got %(value)s",
+                           "bad_value", value=repr(value[:20]))
     return True

@@ -11,6 +11,7 @@ from flask import Blueprint, Response, jsonify, request
 from rover_web.auth import signed_in_name
 from rover_web.core.leases import Closed, Full
 from rover_web.core.state import current_feature
+from rover_web.web.api_messages import explain, text_of
 from rover_web.web.connection import peer_gone
 from rover_web.web.http import ApiError, error_response, json_body, too_many
 from rover_web.web.streams import once, opening, refuse_cross_site
@@ -37,12 +38,12 @@ STATUS = {UnknownTopic: 404, Unavailable: 503, CannotSubscribe: 400}
 
 @bp.errorhandler(InvalidInput)
 def invalid_input(exc: InvalidInput):
-    return error_response(400, exc.code, str(exc))
+    return error_response(400, exc.code, text_of(exc))
 
 
 @bp.errorhandler(StreamRefused)
 def stream_refused(exc: StreamRefused):
-    return error_response(STATUS[type(exc)], exc.code, str(exc))
+    return error_response(STATUS[type(exc)], exc.code, text_of(exc))
 
 
 @bp.get("/stream")
@@ -196,7 +197,7 @@ def snapshot():
     streams = current_feature(CameraStreams)
     wait = streams.snapshots.hit(signed_in_name() or request.remote_addr or "")
     if wait:  # each one may subscribe and decode: one client's loop must not cost everyone's frames
-        raise too_many("snapshot requests (ROVER_WEB_CAMERA_SNAPSHOTS_PER_MIN)", wait)
+        raise too_many(explain("snapshot requests (ROVER_WEB_CAMERA_SNAPSHOTS_PER_MIN)"), wait)
     key = streams.key_for(request.args)
     producer = streams.acquire(key)
     try:
@@ -207,12 +208,13 @@ def snapshot():
     finally:
         streams.release(key)
     if got is None:
-        raise ApiError(504, "no_frame", f"no image arrived on {key.topic} within {streams.snapshot_timeout_s:g} s "
-                                        f"(QoS {key.qos}); is the camera publishing?")
+        raise ApiError(504, "no_frame", "no image arrived on %(topic)s within %(snapshot_timeout_s)s s (QoS "
+                                        "%(qos)s); is the camera publishing?",
+                       topic=key.topic, snapshot_timeout_s=format(streams.snapshot_timeout_s, "g"), qos=key.qos)
     jpeg = got[1]
     if jpeg.error is not None:
         status = 415 if jpeg.error_code == "unsupported_encoding" else 422
-        raise ApiError(status, jpeg.error_code or "bad_image", jpeg.error)
+        raise ApiError(status, jpeg.error_code or "bad_image", jpeg.error_text)
     return Response(jpeg.data, mimetype="image/jpeg",
                     headers={**NO_CACHE, "X-Timestamp": f"{jpeg.stamp:.9f}"})
 

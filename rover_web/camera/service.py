@@ -11,6 +11,7 @@ from rover_web.core.rate_limit import RateLimit
 from rover_web.core.state import Rover
 from rover_web.ros.graph import publishers_best_effort, topic_types
 from rover_web.ros.typesupport import UnknownMessageType, message_class
+from rover_web.web.api_messages import explain, text_of
 from rover_web.web.validate import InvalidInput
 
 from . import imaging
@@ -139,16 +140,20 @@ class CameraStreams:
         if parsed["msg_type"]:
             msg_type = _image_type(parsed["msg_type"])
             if known and msg_type not in known:
-                raise InvalidInput(f"{topic} carries {', '.join(known)}, not {msg_type}", "type_mismatch")
+                raise InvalidInput("%(topic)s carries %(known)s, not %(msg_type)s", "type_mismatch",
+                                   topic=topic, known=', '.join(known), msg_type=msg_type)
         else:
             if not known:
-                raise UnknownTopic(f"no topic {topic} in the ROS graph (GET /api/topics lists them); to wait for a "
-                                   f"camera that is not up yet, add msg_type=sensor_msgs/msg/Image or CompressedImage",
+                raise UnknownTopic(explain("no topic %(topic)s in the ROS graph (GET /api/topics lists them); to "
+                                           "wait for a camera that is not up yet, add "
+                                           "msg_type=sensor_msgs/msg/Image or CompressedImage",
+                                           topic=topic),
                                    "unknown_topic")
             images = [t for t in known if t in camera_msgs.IMAGE_TYPES]
             if not images:
-                raise InvalidInput(f"{topic} carries {', '.join(known)}; streams need sensor_msgs/msg/Image "
-                                   f"or sensor_msgs/msg/CompressedImage", "not_an_image_topic")
+                raise InvalidInput("%(topic)s carries %(known)s; streams need sensor_msgs/msg/Image or "
+                                   "sensor_msgs/msg/CompressedImage", "not_an_image_topic",
+                                   topic=topic, known=', '.join(known))
             msg_type = images[0]
         qos = parsed["qos"]
         if qos is None:  # like `ros2 topic echo`: best effort if any publisher is, or nothing would arrive
@@ -158,27 +163,41 @@ class CameraStreams:
     def acquire(self, key: StreamKey, client: str | None = None) -> FrameProducer:
         with self._lock:
             if self._viewers >= self.max_viewers:
-                raise Unavailable(f"{self._viewers} camera viewers are connected already "
-                                  f"(ROVER_WEB_CAMERA_MAX_VIEWERS)", "too_many_viewers")
+                raise Unavailable(explain("%(viewers)s camera viewers are connected already "
+                                          "(ROVER_WEB_CAMERA_MAX_VIEWERS)",
+                                          viewers=self._viewers), "too_many_viewers")
             self._viewers += 1
         try:
             return self.producers.acquire(key, client, self._share(client))
         except Closed:
             self._viewer_left()
-            raise Unavailable("the server is shutting down", "shutting_down") from None
+            raise Unavailable(explain("the server is shutting down"), "shutting_down") from None
         except ShareUsed as exc:
             self._viewer_left()
-            raise Unavailable(f"{exc} different camera encodings (ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT); close one first",
-                              "too_many_producers") from None
+            raise Unavailable(
+                explain(
+                    "%(why)s different camera encodings (ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT); close one first",
+                    why=text_of(exc),
+                ),
+                "too_many_producers",
+            ) from None
         except Full:
             self._viewer_left()
-            raise Unavailable(f"{len(self.producers)} different camera streams are being encoded already "
-                              f"(ROVER_WEB_CAMERA_MAX_PRODUCERS); view one of them, or try again when one ends",
-                              "too_many_producers") from None
+            raise Unavailable(
+                explain(
+                    "%(count)s different camera streams are being encoded already "
+                    "(ROVER_WEB_CAMERA_MAX_PRODUCERS); view one of them, or try again when one "
+                    "ends",
+                    count=len(self.producers),
+                ),
+                "too_many_producers",
+            ) from None
         except Exception as exc:
             self._viewer_left()
             log.exception("cannot subscribe to %s", key.topic)
-            raise CannotSubscribe(f"cannot subscribe to {key.topic}: {exc}", "cannot_subscribe") from None
+            raise CannotSubscribe(
+                explain("cannot subscribe to %(topic)s: %(why)s", topic=key.topic, why=text_of(exc)), "cannot_subscribe"
+            ) from None
 
     def release(self, key: StreamKey, client: str | None = None) -> None:
         self.producers.release(key, client)
@@ -269,6 +288,9 @@ def _image_type(name: str) -> str:
     try:
         message_class(name)
     except UnknownMessageType as exc:
-        raise InvalidInput(str(exc), "unknown_type") from None
-    raise InvalidInput(f"{name[:80]} is not an image type; use sensor_msgs/msg/Image or "
-                       f"sensor_msgs/msg/CompressedImage", "not_an_image_type")
+        raise InvalidInput(text_of(exc), "unknown_type") from None
+    raise InvalidInput(
+        "%(name)s is not an image type; use sensor_msgs/msg/Image or sensor_msgs/msg/CompressedImage",
+        "not_an_image_type",
+        name=name[:80],
+    )

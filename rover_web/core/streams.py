@@ -13,11 +13,13 @@ from __future__ import annotations
 
 import threading
 
+from rover_web.web.api_messages import explain
+
 
 class TooManyStreams(Exception):
     def __init__(self, limit: int, message: str | None = None):
-        super().__init__(message or f"{limit} streams are open already (ROVER_WEB_MAX_STREAMS); "
-                                    "close a tab or a camera view")
+        super().__init__(message or explain("%(limit)s streams are open already (ROVER_WEB_MAX_STREAMS); "
+                                            "close a tab or a camera view", limit=limit))
         self.limit = limit
 
 
@@ -62,12 +64,16 @@ class StreamLimit:
                 raise TooManyStreams(self.limit)
             held = self._by_client.get(client, 0) if client is not None else 0
             if per_client is not None and client is not None and held >= per_client:
-                raise TooManyStreams(self.limit, f"this client holds {held} streams already, its share "
-                                                 "(ROVER_WEB_MAX_STREAMS_PER_CLIENT); close a tab or a camera view")
+                raise TooManyStreams(self.limit, explain("this client holds %(held)s streams already, its share "
+                                                         "(ROVER_WEB_MAX_STREAMS_PER_CLIENT); close a tab or a "
+                                                         "camera view",
+                                                         held=held))
             kept = min(reserved, self.limit - 1)
             if not may_reserve and self._common >= self.limit - kept:
-                raise TooManyStreams(self.limit, f"{self._common} streams are open; {kept} more are kept for "
-                                                 "driving (ROVER_WEB_STREAMS_RESERVED); close a tab or a camera view")
+                raise TooManyStreams(self.limit, explain("%(common)s streams are open; %(kept)s more are kept for "
+                                                         "driving (ROVER_WEB_STREAMS_RESERVED); close a tab or a "
+                                                         "camera view",
+                                                         common=self._common, kept=kept))
             self._count += 1
             self._common += not may_reserve
             self._open[kind] = self._open.get(kind, 0) + 1

@@ -7,6 +7,7 @@ from flask import Blueprint, abort, jsonify, make_response, render_template, req
 
 from rover_web.auth import require_role, signed_in_name
 from rover_web.core.state import current_feature, current_rover
+from rover_web.web.api_messages import explain, text_of
 from rover_web.web.http import ApiError, accepts_form, error_response, json_body, too_many
 from rover_web.web.validate import InvalidInput, only_keys, text
 
@@ -33,7 +34,7 @@ def client_name(raw: object) -> str:
 @bp.app_errorhandler(EStopEngaged)
 def estop_engaged(exc: EStopEngaged):
     """Any feature's view that raises EStopEngaged answers the same 409."""
-    response = error_response(409, "estop_engaged", str(exc))
+    response = error_response(409, "estop_engaged", text_of(exc))
     return response
 
 
@@ -64,7 +65,7 @@ def estop_all():
             raise InvalidInput("'engaged' must be true (this route only engages)", "bad_type")
         by = text(body, "by", max_len=NAME_MAX_LEN, default=None)
     except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, text_of(exc)) from None
     return _engage_all(client_name(by))
 
 
@@ -86,7 +87,7 @@ def login_estop():
     # without ROVER_WEB_PROXY_HOPS) with someone who spent it first.
     if wait_s > 0 and fleet_estop.all_engaged:
         if as_json:
-            raise too_many("e-stop engages from the sign-in page, and every robot is already engaged", wait_s)
+            raise too_many(explain("e-stop engages from the sign-in page, and every robot is already engaged"), wait_s)
         return _login_page(429, "every robot's e-stop is already engaged, and this address pressed too often: "
                                 f"try again in {wait_s:.0f} s",
                            retry_after_s=wait_s)
@@ -141,9 +142,9 @@ def estop_set():
             raise InvalidInput("'engaged' must be true or false", "bad_type")
         by = text(body, "by", max_len=NAME_MAX_LEN, default=None)
     except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, text_of(exc)) from None
     require_role("operator")  # anyone may stop the robot; only an operator may let it move again
     try:
         return jsonify(estop.release(client_name(by)))
     except ReleaseRefused as exc:
-        raise ApiError(exc.status, exc.code, str(exc)) from None
+        raise ApiError(exc.status, exc.code, text_of(exc)) from None

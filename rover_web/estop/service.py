@@ -17,6 +17,8 @@ import threading
 import time
 from collections.abc import Callable
 
+from rover_web.web.api_messages import explain
+
 from .store import EStopStore
 
 log = logging.getLogger(__name__)
@@ -28,8 +30,11 @@ class EStopEngaged(Exception):
     """A request that would move the robot while the e-stop is engaged."""
 
     def __init__(self, state: dict):
-        by = f" by {state['by']}" if state.get("by") else ""
-        super().__init__(f"the e-stop is engaged{by}: release it before sending motion")
+        if state.get("by"):
+            super().__init__(explain("the e-stop is engaged by %(name)s: release it before sending motion",
+                                     name=state["by"]))
+        else:
+            super().__init__(explain("the e-stop is engaged: release it before sending motion"))
         self.state = state
 
 
@@ -130,8 +135,8 @@ class EStopService:
                 self._store.save(released)
             except Exception:
                 log.exception("could not record the e-stop release")
-                raise ReleaseRefused("estop_not_recorded", "the release could not be written to the database; "
-                                     "the e-stop stays engaged", 503) from None
+                raise ReleaseRefused("estop_not_recorded", explain("the release could not be written to the "
+                                                                   "database; the e-stop stays engaged"), 503) from None
             with self._lock:
                 if self._epoch != epoch:  # engaged again while the release was written
                     again = dict(self._state)
@@ -144,7 +149,7 @@ class EStopService:
                     again = None
             if again is not None:
                 self._persist(again)  # the disk must not keep the abandoned release
-                raise ReleaseRefused("estop_engaged", "the e-stop was engaged again while releasing", 409)
+                raise ReleaseRefused("estop_engaged", explain("the e-stop was engaged again while releasing"), 409)
         log.warning("e-stop released by %s", by)
         for hook in self._release_hooks:
             self._run_hook(hook, by)

@@ -18,6 +18,8 @@ from collections import deque
 from collections.abc import Iterable
 from typing import Any
 
+from rover_web.web.api_messages import explain
+
 CHANNEL_RE = re.compile(r"[a-z][a-z0-9_]{0,31}\Z")
 
 
@@ -190,7 +192,7 @@ class EventHub:
     def subscribe(self, channels: Iterable[str], last_event_id: int | None = None) -> Subscription:
         with self._cond:
             if self._clients >= self._max_clients:
-                raise TooManyClients(f"{self._clients} event streams are open already")
+                raise TooManyClients(explain("%(clients)s event streams are open already", clients=self._clients))
             self._clients += 1
             channels = frozenset(channels)
             for channel in channels:

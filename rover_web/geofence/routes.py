@@ -7,6 +7,7 @@ from flask import Blueprint, jsonify, request
 
 from rover_web.auth import require_role, signed_in_name
 from rover_web.core.state import current_feature
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import error_response, json_body
 from rover_web.web.validate import InvalidInput
 
@@ -32,7 +33,7 @@ def put_fence():
 
 @bp.errorhandler(InvalidInput)
 def _invalid(exc: InvalidInput):
-    return error_response(400, exc.code, str(exc))
+    return error_response(400, exc.code, text_of(exc))
 
 
 def outside_geofence_response(exc: OutsideGeofence):

@@ -26,6 +26,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from rover_web.web.api_messages import explain
 from rover_web.web.validate import InvalidInput
 
 if TYPE_CHECKING:
@@ -91,11 +92,13 @@ class Fence:
         from shapely.geometry import Point
         point = Point(lng, lat)
         if self.keep_in is not None and not self.keep_in.covers(point):
-            return OutsideGeofence(f"({lng:.7f}, {lat:.7f}) is outside every keep-in area of the geofence",
+            return OutsideGeofence(explain("(%(lng)s, %(lat)s) is outside every keep-in area of the geofence",
+                                           lng=format(lng, ".7f"), lat=format(lat, ".7f")),
                                    reason="outside_keep_in", lng=lng, lat=lat)
         for area in self.keep_out:
             if area.geometry.intersects(point):
-                return OutsideGeofence(f"({lng:.7f}, {lat:.7f}) is inside the geofence's {area.title}",
+                return OutsideGeofence(explain("(%(lng)s, %(lat)s) is inside the geofence's %(title)s",
+                                               lng=format(lng, ".7f"), lat=format(lat, ".7f"), title=area.title),
                                        reason="inside_keep_out", lng=lng, lat=lat, feature=area.index,
                                        name=area.name)
         return None
@@ -117,7 +120,9 @@ class Fence:
             refused = self.refusal(lng, lat)
             if refused is not None:
                 refused.details["waypoint"] = i
-                raise OutsideGeofence(f"waypoint {i + 1}: {refused}", **refused.details)
+                raise OutsideGeofence(
+                    explain("waypoint %(value)s: %(refused)s", value=i + 1, refused=refused), **refused.details
+                )
         for i in range(len(points) - 1):
             a, b = points[i], points[i + 1]
             if a == b:
@@ -125,13 +130,23 @@ class Fence:
             leg = LineString([a, b])
             where = dict(leg=[i, i + 1], lng=None, lat=None)
             if self.keep_in is not None and not self.keep_in.covers(leg):
-                raise OutsideGeofence(f"the leg from waypoint {i + 1} to {i + 2} leaves the keep-in area "
-                                      "of the geofence", reason="leg_leaves_keep_in", **where)
+                raise OutsideGeofence(explain("the leg from waypoint %(value)s to %(value2)s leaves the keep-in "
+                                              "area of the geofence",
+                                              value=i + 1, value2=i + 2), reason="leg_leaves_keep_in", **where)
             for area in self.keep_out:
                 if area.geometry.intersects(leg):
-                    raise OutsideGeofence(f"the leg from waypoint {i + 1} to {i + 2} crosses the geofence's "
-                                          f"{area.title}", reason="leg_crosses_keep_out", feature=area.index,
-                                          name=area.name, **where)
+                    raise OutsideGeofence(
+                        explain(
+                            "the leg from waypoint %(value)s to %(value2)s crosses the geofence's %(title)s",
+                            value=i + 1,
+                            value2=i + 2,
+                            title=area.title,
+                        ),
+                        reason="leg_crosses_keep_out",
+                        feature=area.index,
+                        name=area.name,
+                        **where,
+                    )
 
 
 def _feature(area: Area) -> dict:
@@ -160,7 +175,8 @@ def parse_fence(doc: Any, max_vertices: int) -> Fence:
     """A Fence from a GeoJSON FeatureCollection; InvalidInput naming the feature and what is wrong."""
     if not isinstance(doc, dict) or doc.get("type") != "FeatureCollection":
         kind = doc.get("type") if isinstance(doc, dict) else type(doc).__name__
-        raise InvalidInput(f"expected a GeoJSON FeatureCollection, got {str(kind)[:40]!r}", "bad_geojson")
+        raise InvalidInput("expected a GeoJSON FeatureCollection, got %(kind)s", "bad_geojson",
+                           kind=repr(str(kind)[:40]))
     features = doc.get("features")
     if not isinstance(features, list):
         raise InvalidInput("'features' must be a list of Polygon or MultiPolygon features", "bad_geojson")
@@ -175,26 +191,27 @@ class _VertexCounter:
     def add(self, n: int, where: str) -> None:
         self.count += n
         if self.count > self.limit:
-            raise InvalidInput(f"{where}: the fence has more than {self.limit} vertices "
-                               "(ROVER_WEB_GEOFENCE_MAX_VERTICES); simplify it", "too_many_vertices")
+            raise InvalidInput("%(where)s: the fence has more than %(limit)s vertices "
+                               "(ROVER_WEB_GEOFENCE_MAX_VERTICES); simplify it", "too_many_vertices",
+                               where=where, limit=self.limit)
 
 
 def _area(i: int, feature: Any, counter: _VertexCounter) -> Area:
     where = f"features[{i}]"
     if not isinstance(feature, dict) or feature.get("type") != "Feature":
-        raise InvalidInput(f"{where} must be a GeoJSON Feature", "bad_geojson")
+        raise InvalidInput("%(where)s must be a GeoJSON Feature", "bad_geojson", where=where)
     properties = feature.get("properties")
     if not isinstance(properties, dict):
-        raise InvalidInput(f"{where}.properties must be an object with \"kind\": \"keep_in\" or \"keep_out\"",
-                           "bad_geojson")
+        raise InvalidInput("%(where)s.properties must be an object with \"kind\": \"keep_in\" or \"keep_out\"",
+                           "bad_geojson", where=where)
     kind = properties.get("kind")
     if kind not in KINDS:
-        raise InvalidInput(f"{where}.properties.kind must be \"keep_in\" or \"keep_out\", got {str(kind)[:40]!r}",
-                           "bad_geojson")
+        raise InvalidInput("%(where)s.properties.kind must be \"keep_in\" or \"keep_out\", got %(kind)s",
+                           "bad_geojson", where=where, kind=repr(str(kind)[:40]))
     name = properties.get("name") or ""
     if not isinstance(name, str) or len(name) > MAX_NAME_CHARS or any(ord(c) < 32 for c in name):
-        raise InvalidInput(f"{where}.properties.name must be a string of at most {MAX_NAME_CHARS} printable "
-                           "characters", "bad_geojson")
+        raise InvalidInput("%(where)s.properties.name must be a string of at most %(max_name_chars)s printable "
+                           "characters", "bad_geojson", where=where, max_name_chars=MAX_NAME_CHARS)
     if name:
         where = f"{where} ({name!r})"
     import shapely
@@ -207,27 +224,31 @@ def _area(i: int, feature: Any, counter: _VertexCounter) -> Area:
         shape = _polygon(coordinates, f"{where}.geometry.coordinates", counter)
     elif gtype == "MultiPolygon":
         if not isinstance(coordinates, list) or not coordinates:
-            raise InvalidInput(f"{where}.geometry.coordinates must be a non-empty list of polygons", "bad_geojson")
+            raise InvalidInput("%(where)s.geometry.coordinates must be a non-empty list of polygons", "bad_geojson",
+                               where=where)
         shape = MultiPolygon([_polygon(p, f"{where}.geometry.coordinates[{j}]", counter)
                               for j, p in enumerate(coordinates)])
     else:
-        raise InvalidInput(f"{where}.geometry must be a Polygon or MultiPolygon, got {str(gtype)[:40]!r}",
-                           "bad_geojson")
+        raise InvalidInput("%(where)s.geometry must be a Polygon or MultiPolygon, got %(gtype)s",
+                           "bad_geojson", where=where, gtype=repr(str(gtype)[:40]))
     min_lng, _, max_lng, _ = shape.bounds
     if max_lng - min_lng > 180:
-        raise InvalidInput(f"{where} spans more than 180 degrees of longitude: polygons across the antimeridian "
-                           "are not supported", "antimeridian")
+        raise InvalidInput("%(where)s spans more than 180 degrees of longitude: polygons across the antimeridian are "
+                           "not supported", "antimeridian", where=where)
     reason = shapely.is_valid_reason(shape)
     if reason != "Valid Geometry":
-        raise InvalidInput(f"{where} is not a valid polygon: {reason}", "invalid_geometry")
+        raise InvalidInput(
+            "%(where)s is not a valid polygon: %(reason)s", "invalid_geometry", where=where, reason=reason
+        )
     if shape.area <= 0:
-        raise InvalidInput(f"{where} has no area", "invalid_geometry")
+        raise InvalidInput("%(where)s has no area", "invalid_geometry", where=where)
     return Area(i, kind, name, shape)
 
 
 def _polygon(rings: Any, where: str, counter: _VertexCounter) -> Polygon:
     if not isinstance(rings, list) or not rings:
-        raise InvalidInput(f"{where} must be a list of linear rings (the outline, then any holes)", "bad_geojson")
+        raise InvalidInput("%(where)s must be a list of linear rings (the outline, then any holes)", "bad_geojson",
+                           where=where)
     from shapely.geometry import Polygon
 
     parsed = [_ring(r, f"{where}[{k}]", counter) for k, r in enumerate(rings)]
@@ -236,31 +257,33 @@ def _polygon(rings: Any, where: str, counter: _VertexCounter) -> Polygon:
 
 def _ring(ring: Any, where: str, counter: _VertexCounter) -> list[tuple[float, float]]:
     if not isinstance(ring, list) or len(ring) < 4:
-        raise InvalidInput(f"{where} must be a closed ring of at least 4 positions (the first repeated last)",
-                           "bad_geojson")
+        raise InvalidInput("%(where)s must be a closed ring of at least 4 positions (the first repeated last)",
+                           "bad_geojson", where=where)
     counter.add(len(ring), where)
     points = [_position(p, f"{where}[{n}]") for n, p in enumerate(ring)]
     if points[0] != points[-1]:
-        raise InvalidInput(f"{where} is not closed: its last position must repeat its first", "bad_geojson")
+        raise InvalidInput("%(where)s is not closed: its last position must repeat its first", "bad_geojson",
+                           where=where)
     for n in range(len(points) - 1):
         if abs(points[n + 1][0] - points[n][0]) > 180:
-            raise InvalidInput(f"{where}: the edge from position {n} to {n + 1} crosses the antimeridian; "
-                               "polygons across it are not supported", "antimeridian")
+            raise InvalidInput("%(where)s: the edge from position %(n)s to %(value)s crosses the antimeridian; "
+                               "polygons across it are not supported", "antimeridian", where=where, n=n, value=n + 1)
     return points
 
 
 def _position(position: Any, where: str) -> tuple[float, float]:
     if not isinstance(position, list) or len(position) not in (2, 3):
-        raise InvalidInput(f"{where} must be [lng, lat] or [lng, lat, altitude]", "bad_geojson")
+        raise InvalidInput("%(where)s must be [lng, lat] or [lng, lat, altitude]", "bad_geojson", where=where)
     values = []
     for value, label, limit in zip(position[:2], ("lng", "lat"), (180.0, 90.0), strict=True):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise InvalidInput(f"{where} ({label}) must be a number", "bad_type")
+            raise InvalidInput("%(where)s (%(label)s) must be a number", "bad_type", where=where, label=label)
         try:
             number = float(value)
         except OverflowError:
             number = math.inf
         if not math.isfinite(number) or not -limit <= number <= limit:
-            raise InvalidInput(f"{where} ({label}) must be between {-limit:g} and {limit:g}", "out_of_range")
+            raise InvalidInput("%(where)s (%(label)s) must be between %(value)s and %(limit)s", "out_of_range",
+                               where=where, label=label, value=format(-limit, "g"), limit=format(limit, "g"))
         values.append(number)
     return values[0], values[1]

@@ -7,6 +7,7 @@ from flask import Blueprint, current_app, jsonify, redirect, render_template, re
 from rover_web.auth import signed_in_name
 from rover_web.basemap.source import map_view
 from rover_web.core.state import current_feature
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import ApiError, json_body
 from rover_web.web.validate import InvalidInput, only_keys, text
 from rover_web.zenoh_link.session import NAME
@@ -64,9 +65,10 @@ def robot_history(name: str):
         before = _int_arg("before", 1, 2**62)
         limit = _int_arg("limit", 1, PAGE_MAX)
     except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, text_of(exc)) from None
     if not NAME.match(name) or (name not in hub.directory.names() and not hub.history.known(name)):
-        raise ApiError(404, "unknown_robot", f"the hub has no robot {name[:40]!r} heard or in its history")
+        raise ApiError(404, "unknown_robot", "the hub has no robot %(name)s heard or in its history",
+                       name=repr(name[:40]))
     return jsonify(hub.history.page(name, before=before, limit=limit or 50))
 
 
@@ -75,7 +77,8 @@ def _int_arg(key: str, low: int, high: int) -> int | None:
     if raw is None:
         return None
     if not raw.isdigit() or len(raw) > 19 or not low <= int(raw) <= high:
-        raise InvalidInput(f"{key} must be a whole number from {low} to {high}", "bad_value")
+        raise InvalidInput("%(key)s must be a whole number from %(low)s to %(high)s", "bad_value",
+                           key=key, low=low, high=high)
     return int(raw)
 
 
@@ -93,7 +96,7 @@ def estop_all():
                            "(POST {\"engaged\": false} to its /api/estop)")
         by = text(body, "by", max_len=NAME_MAX_LEN, default=None)
     except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, text_of(exc)) from None
     who = signed_in_name() or by or request.remote_addr or "unknown"
     return jsonify(_hub().stop_robots(who[:NAME_MAX_LEN]))
 

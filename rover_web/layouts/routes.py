@@ -7,6 +7,7 @@ from flask import Blueprint, jsonify, request
 
 from rover_web.auth import signed_in_name
 from rover_web.core.state import current_feature
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import ApiError, error_response, json_body
 from rover_web.web.validate import InvalidInput, only_keys
 
@@ -28,7 +29,8 @@ def _by() -> str:
 def _found(layout_id: int) -> dict:
     doc = _service().store.get(layout_id)
     if doc is None:
-        raise ApiError(404, "not_found", f"no layout {layout_id} on this robot; GET /api/layouts lists them")
+        raise ApiError(404, "not_found", "no layout %(layout_id)s on this robot; GET /api/layouts lists them",
+                       layout_id=layout_id)
     return doc
 
 
@@ -85,7 +87,8 @@ def choose_layout():
         raise ApiError(400, "bad_type" if "id" in body else "missing_field", "'id' must be a layout's id (an integer)")
     service = _service()
     if not service.store.choose(service.user_key(), layout_id):
-        raise ApiError(404, "not_found", f"no layout {layout_id} on this robot; GET /api/layouts lists them")
+        raise ApiError(404, "not_found", "no layout %(layout_id)s on this robot; GET /api/layouts lists them",
+                       layout_id=layout_id)
     return jsonify(id=layout_id, user=signed_in_name())
 
 
@@ -98,10 +101,10 @@ def _invalid(exc: InvalidLayout):
 
 @bp.errorhandler(InvalidInput)
 def _invalid_input(exc: InvalidInput):
-    return error_response(400, exc.code, str(exc))
+    return error_response(400, exc.code, text_of(exc))
 
 
 @bp.errorhandler(NameTaken)
 def _name_taken(exc: NameTaken):
-    return error_response(409, "name_taken", f"a layout named {str(exc)!r} exists on this robot; choose another "
-                                             "name or PUT that layout")
+    return error_response(409, "name_taken", "a layout named %(name)s exists on this robot; choose another name or "
+                                             "PUT that layout", name=repr(str(exc)))

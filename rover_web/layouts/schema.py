@@ -15,6 +15,8 @@ from __future__ import annotations
 import functools
 from typing import Any
 
+from rover_web.web.api_messages import explain
+
 from .cards import CARDS
 
 VERSION = 1
@@ -73,7 +75,7 @@ class InvalidLayout(ValueError):
     """What is wrong, where (`field`, e.g. "cards[2].w") and a short code."""
 
     def __init__(self, field: str, message: str, code: str):
-        super().__init__(f"{field}: {message}" if field else message)
+        super().__init__(explain("%(field)s: %(why)s", field=field, why=message) if field else message)
         self.field, self.code = field, code
 
 
@@ -94,30 +96,36 @@ def _first_error(validator, doc: Any, prefix: list) -> None:
     if error.validator == "required":
         missing = message.split("'")[1] if message.count("'") >= 2 else ""
         path.append(missing)
-        message = "is required"
+        why_text = explain("is required")
     elif error.validator == "additionalProperties":
-        message = f"{message}; allowed: {', '.join(sorted(error.schema.get('properties', {}))) or 'none'}"
+        allowed = ", ".join(sorted(error.schema.get("properties", {})))
+        if allowed:
+            why_text = explain("%(why)s; allowed: %(allowed)s", why=message, allowed=allowed)
+        else:
+            why_text = explain("%(why)s; allowed: none", why=message)
     elif error.validator == "const" and path == ["version"]:
-        message = f"this server reads layout version {VERSION}; got {error.instance!r:.20}"
+        why_text = explain("this server reads layout version %(version)s; got %(got)s", version=VERSION,
+                           got=repr(error.instance)[:20])
     elif error.validator == "maxLength":
-        message = f"is longer than {error.validator_value} characters"
+        why_text = explain("is longer than %(max_len)s characters", max_len=error.validator_value)
     elif error.validator == "maxItems":
-        message = f"holds more than {error.validator_value} items"
+        why_text = explain("holds more than %(max_items)s items", max_items=error.validator_value)
     elif error.validator == "enum":
-        message = f"{error.instance!r:.40} is not one of {', '.join(map(str, error.validator_value))}"
+        why_text = explain("%(got)s is not one of %(choices)s", got=repr(error.instance)[:40],
+                           choices=", ".join(map(str, error.validator_value)))
     elif error.validator == "pattern" and path and path[-1] == "name":
-        message = "must not be blank or hold control characters"
+        why_text = explain("must not be blank or hold control characters")
     elif error.validator == "pattern":
-        message = f"{error.instance!r:.80} is not valid here"
-    else:
-        message = message if len(message) <= 200 else message[:200] + "…"
-    raise InvalidLayout(field_name(path), message, CODES.get(error.validator, "bad_value"))
+        why_text = explain("%(got)s is not valid here", got=repr(error.instance)[:80])
+    else:  # jsonschema's own English words, as they are
+        why_text = explain("%(why)s", why=message if len(message) <= 200 else message[:200] + "…")
+    raise InvalidLayout(field_name(path), why_text, CODES.get(error.validator, "bad_value"))
 
 
 def validate(doc: Any) -> dict:
     """The layout, checked and normalised (settings always present, integers as int); InvalidLayout if not."""
     if not isinstance(doc, dict):
-        raise InvalidLayout("", "a layout is a JSON object", "bad_json")
+        raise InvalidLayout("", explain("a layout is a JSON object"), "bad_json")
     layout_validator, settings_validators = _validators()
     _first_error(layout_validator, doc, [])
     cards = []
@@ -130,21 +138,28 @@ def validate(doc: Any) -> dict:
         _first_error(settings_validators[card.name], values, ["cards", i, "settings"])
         x, y, w, h = (int(raw[k]) for k in ("x", "y", "w", "h"))
         if x + w > COLUMNS:
-            raise InvalidLayout(f"{where}.w", f"x + w is {x + w}: the grid is {COLUMNS} columns wide", "out_of_grid")
+            raise InvalidLayout(f"{where}.w", explain("x + w is %(value)s: the grid is %(columns)s columns wide",
+                                                      value=x + w, columns=COLUMNS), "out_of_grid")
         if y + h > ROWS:
-            raise InvalidLayout(f"{where}.h", f"y + h is {y + h}: the grid is at most {ROWS} rows tall",
+            raise InvalidLayout(f"{where}.h", explain("y + h is %(value)s: the grid is at most %(rows)s rows tall",
+                                                      value=y + h, rows=ROWS),
                                 "out_of_grid")
         once_key = card.name + (f":{values.get('panel', '')}" if card.name == "panel" else "")
         if card.once or card.name == "panel":
             if once_key in seen_once:
-                raise InvalidLayout(f"{where}.type", f"a layout holds at most one {card.name} card"
-                                    + (" per panel" if card.name == "panel" else "")
-                                    + f" (cards[{seen_once[once_key]}] is one)", "duplicate_card")
+                if card.name == "panel":
+                    why_text = explain("a layout holds at most one %(card)s card per panel (cards[%(other)s] is one)",
+                                       card=card.name, other=seen_once[once_key])
+                else:
+                    why_text = explain("a layout holds at most one %(card)s card (cards[%(other)s] is one)",
+                                       card=card.name, other=seen_once[once_key])
+                raise InvalidLayout(f"{where}.type", why_text, "duplicate_card")
             seen_once[once_key] = i
         for cx in range(x, x + w):
             for cy in range(y, y + h):
                 if (cx, cy) in taken:
-                    raise InvalidLayout(where, f"overlaps cards[{taken[cx, cy]}] at x={cx}, y={cy}", "overlap")
+                    raise InvalidLayout(where, explain("overlaps cards[%(taken)s] at x=%(cx)s, y=%(cy)s",
+                                                       taken=taken[cx, cy], cx=cx, cy=cy), "overlap")
                 taken[cx, cy] = i
         cards.append({"type": card.name, "x": x, "y": y, "w": w, "h": h, "settings": values})
     return {"version": VERSION, "name": doc["name"].strip(), "cards": cards}

@@ -25,25 +25,35 @@ def covariance(value) -> tuple[float, ...]:
     cells = []
     for i, v in enumerate(value):
         if isinstance(v, bool) or not isinstance(v, (int, float)):
-            raise InvalidInput(f"'covariance[{i}]' must be a number", "bad_type")
+            raise InvalidInput("'covariance[%(i)s]' must be a number", "bad_type", i=i)
         try:
             v = float(v)
         except OverflowError:
-            raise InvalidInput(f"'covariance[{i}]' is out of range", "out_of_range") from None
+            raise InvalidInput("'covariance[%(i)s]' is out of range", "out_of_range", i=i) from None
         if not math.isfinite(v):
-            raise InvalidInput(f"'covariance[{i}]' must be finite", "non_finite")
+            raise InvalidInput("'covariance[%(i)s]' must be finite", "non_finite", i=i)
         if abs(v) > MAX_VARIANCE:
-            raise InvalidInput(f"'covariance[{i}]' must be within ±{MAX_VARIANCE:g}", "out_of_range")
+            raise InvalidInput("'covariance[%(i)s]' must be within ±%(max_variance)s", "out_of_range",
+                               i=i, max_variance=format(MAX_VARIANCE, "g"))
         cells.append(v)
     for row in range(SIDE):
         if cells[row * SIDE + row] < 0:
-            raise InvalidInput(f"'covariance[{row * SIDE + row}]' is a variance on the diagonal: it cannot be "
-                               "negative", "out_of_range")
+            raise InvalidInput(
+                "'covariance[%(value)s]' is a variance on the diagonal: it cannot be negative",
+                "out_of_range",
+                value=row * SIDE + row,
+            )
         for col in range(row + 1, SIDE):
             a, b = cells[row * SIDE + col], cells[col * SIDE + row]
             if abs(a - b) > SYMMETRY_TOLERANCE * max(1.0, abs(a), abs(b)):
-                raise InvalidInput(f"'covariance' must be symmetric: [{row * SIDE + col}] is {a:g} but "
-                                   f"[{col * SIDE + row}] is {b:g}", "bad_value")
+                raise InvalidInput(
+                    "'covariance' must be symmetric: [%(value)s] is %(a)s but [%(value2)s] is %(b)s",
+                    "bad_value",
+                    value=row * SIDE + col,
+                    a=format(a, "g"),
+                    value2=col * SIDE + row,
+                    b=format(b, "g"),
+                )
     return tuple(cells)
 
 

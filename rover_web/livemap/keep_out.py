@@ -15,6 +15,7 @@ from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
 from rover_web.geofence import OutsideGeofence
+from rover_web.web.api_messages import explain
 
 if TYPE_CHECKING:
     from shapely.geometry import Polygon
@@ -94,5 +95,6 @@ def check_goal(areas: tuple[KeepOutArea, ...], map_name: str, x: float, y: float
     for i, area in enumerate(areas):
         if area.polygon.intersects(point):
             title = f"keep-out area {area.name!r}" if area.name else f"keep-out area {i}"
-            raise OutsideGeofence(f"({x:g}, {y:g}) is inside the {title} of {map_name!r}",
+            raise OutsideGeofence(explain("(%(x)s, %(y)s) is inside the %(title)s of %(map_name)s",
+                                          x=format(x, "g"), y=format(y, "g"), title=title, map_name=repr(map_name)),
                                   reason="inside_keep_out", x=x, y=y, feature=i, name=area.name)

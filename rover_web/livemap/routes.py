@@ -9,6 +9,7 @@ from flask import Blueprint, Response, abort, jsonify, redirect, render_template
 
 from rover_web.core.state import current_feature
 from rover_web.geofence import OutsideGeofence, outside_geofence_response
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import ApiError, error_response, json_body
 from rover_web.web.validate import InvalidInput, number, only_keys
 
@@ -22,8 +23,8 @@ bp = Blueprint("livemap", __name__)
 
 def answer_map_errors(blueprint: Blueprint) -> None:
     """A pose refused by a floorplan, answered the same by every blueprint that checks one (nav2's too)."""
-    blueprint.register_error_handler(UnknownMap, lambda exc: error_response(404, "unknown_map", str(exc)))
-    blueprint.register_error_handler(OutsideMap, lambda exc: error_response(400, "outside_map", str(exc)))
+    blueprint.register_error_handler(UnknownMap, lambda exc: error_response(404, "unknown_map", text_of(exc)))
+    blueprint.register_error_handler(OutsideMap, lambda exc: error_response(400, "outside_map", text_of(exc)))
     blueprint.register_error_handler(OutsideGeofence, outside_geofence_response)
 
 
@@ -32,7 +33,7 @@ answer_map_errors(bp)
 
 @bp.errorhandler(ShuttingDown)
 def shutting_down(exc: ShuttingDown):
-    return error_response(503, "stopping", str(exc))
+    return error_response(503, "stopping", text_of(exc))
 
 
 def map_summary(definition: MapDefinition) -> dict:
@@ -126,11 +127,11 @@ def map_state(name: str):
         try:
             cm_per_pixel = float(raw)
         except ValueError:
-            raise ApiError(400, "bad_type", f"cm_per_pixel must be a number, got {raw[:40]!r}") from None
+            raise ApiError(400, "bad_type", "cm_per_pixel must be a number, got %(raw)s", raw=repr(raw[:40])) from None
     try:
         live = feature.live_map(name, cm_per_pixel)
     except ValueError as exc:
-        raise ApiError(400, "out_of_range", str(exc)) from None
+        raise ApiError(400, "out_of_range", text_of(exc)) from None
     return jsonify(live.map_state)
 
 
@@ -155,7 +156,7 @@ def post_goal(name: str):
         y = number(body, "y")
         yaw = number(body, "yaw", default=0.0)
     except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, text_of(exc)) from None
     goal = feature.send_goal(definition, x, y, yaw)
     payload = goal_payload(goal, [definition])
     return jsonify(status="sent", topic=feature.goal_topic, goal=payload)
@@ -169,6 +170,6 @@ def post_initial_pose(name: str):
     try:
         x, y, yaw, covariance = initial_pose.parse(body)
     except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, text_of(exc)) from None
     sent = feature.send_initial_pose(definition, x, y, yaw, covariance)
     return jsonify(status="sent", topic=feature.initial_pose_topic, initial_pose=sent)

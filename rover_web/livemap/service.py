@@ -18,6 +18,7 @@ from rover_web.config import ConfigError
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
 from rover_web.placement import MAP, TF, MapPlacer, Unplaceable, tf_buffer
+from rover_web.web.api_messages import explain
 
 from . import msgs
 from .geometry import MapGeometry, wrap_angle
@@ -63,9 +64,19 @@ def check_on_map(definition: MapDefinition, x: float, y: float) -> None:
     if not definition.geometry.contains(x, y):
         g = definition.geometry
         corners = [g.pixel_to_world(*c) for c in ((0, g.height_px), (g.width_px, 0))]
-        raise OutsideMap(f"({x:g}, {y:g}) is outside {definition.name!r}, which spans "
-                         f"x {min(corners[0][0], corners[1][0]):g}..{max(corners[0][0], corners[1][0]):g} m, "
-                         f"y {min(corners[0][1], corners[1][1]):g}..{max(corners[0][1], corners[1][1]):g} m")
+        raise OutsideMap(
+            explain(
+                "(%(x)s, %(y)s) is outside %(name)s, which spans x %(corners)s..%(corners2)s m, y "
+                "%(corners3)s..%(corners4)s m",
+                x=format(x, "g"),
+                y=format(y, "g"),
+                name=repr(definition.name),
+                corners=format(min(corners[0][0], corners[1][0]), "g"),
+                corners2=format(max(corners[0][0], corners[1][0]), "g"),
+                corners3=format(min(corners[0][1], corners[1][1]), "g"),
+                corners4=format(max(corners[0][1], corners[1][1]), "g"),
+            )
+        )
 
 
 class LiveMapService:
@@ -116,7 +127,7 @@ class LiveMapService:
         if definition is None and name == LIVE_MAP_NAME:
             definition = self.live
         if definition is None:
-            raise UnknownMap(f"no map named {name[:80]!r}; GET /api/maps lists them")
+            raise UnknownMap(explain("no map named %(name)s; GET /api/maps lists them", name=repr(name[:80])))
         return definition
 
     def live_map(self, name: str, cm_per_pixel: float | None) -> LiveMap:
@@ -218,7 +229,7 @@ class LiveMapService:
         check_on_map(definition, x, y)
         check_goal(definition.keep_out, definition.name, x, y)  # OutsideGeofence: 422, nothing sent
         if self.rover.stopping.is_set():
-            raise ShuttingDown("the server is shutting down; no goal was sent")
+            raise ShuttingDown(explain("the server is shutting down; no goal was sent"))
         self.estop.check_motion()
         yaw = wrap_angle(yaw)
         with self._goal_lock:
@@ -239,7 +250,7 @@ class LiveMapService:
         """
         check_on_map(definition, x, y)
         if self.rover.stopping.is_set():
-            raise ShuttingDown("the server is shutting down; no initial pose was sent")
+            raise ShuttingDown(explain("the server is shutting down; no initial pose was sent"))
         self.estop.check_motion()
         yaw = wrap_angle(yaw)
         stamp = self.rover.runtime.now_msg()

@@ -23,6 +23,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 from rover_web.config import ROOT
+from rover_web.web.api_messages import explain
 
 from .geometry import wrap_angle
 from .map_files import MapDefinition, load_catalog
@@ -62,15 +63,17 @@ class LiveMap:
         catalog = _catalog_default() if catalog is None else catalog
         definition = catalog.get(map_name)
         if definition is None:
-            raise UnknownMap(f"no map named {map_name!r}; known: {', '.join(catalog)}")
+            raise UnknownMap(explain("no map named %(map_name)s; known: %(catalog)s",
+                                     map_name=repr(map_name), catalog=', '.join(catalog)))
         geometry = definition.geometry
         if cm_per_pixel is None:
             cm_per_pixel = geometry.cm_per_pixel
         if isinstance(cm_per_pixel, bool) or not isinstance(cm_per_pixel, (int, float)) \
                 or not math.isfinite(cm_per_pixel) or not MIN_CM_PER_PIXEL <= cm_per_pixel <= MAX_CM_PER_PIXEL:
-            raise ValueError(f"cm_per_pixel must be a number from {MIN_CM_PER_PIXEL:g} to {MAX_CM_PER_PIXEL:g}")
+            raise ValueError(explain("cm_per_pixel must be a number from %(low)s to %(high)s",
+                                     low=format(MIN_CM_PER_PIXEL, "g"), high=format(MAX_CM_PER_PIXEL, "g")))
         if not (math.isfinite(bot_cm_diameter) and bot_cm_diameter > 0):
-            raise ValueError("bot_cm_diameter must be a positive number of centimetres")
+            raise ValueError(explain("bot_cm_diameter must be a positive number of centimetres"))
         self.definition = definition
         self.geometry = geometry
         self.cm_per_pixel = float(cm_per_pixel)

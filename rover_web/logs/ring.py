@@ -12,6 +12,8 @@ import threading
 import time
 from collections import deque
 
+from rover_web.web.api_messages import explain
+
 LEVELS = {"DEBUG": 10, "INFO": 20, "WARN": 30, "ERROR": 40, "FATAL": 50}
 NAMES = {v: k for k, v in LEVELS.items()}
 ERROR_WINDOW_S = 60.0
@@ -36,7 +38,8 @@ def parse_level(text: str) -> int:
         return LEVELS[key]
     if key.isdigit() and 0 <= int(key) <= 255:
         return int(key)
-    raise ValueError(f"level must be one of {', '.join(LEVELS)} or a number 0-255, not {text[:20]!r}")
+    raise ValueError(explain("level must be one of %(levels)s or a number 0-255, not %(value)s",
+                             levels=", ".join(LEVELS), value=repr(text[:20])))
 
 
 def same_line(a: dict, b: dict) -> bool:

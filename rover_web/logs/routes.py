@@ -5,6 +5,7 @@ from __future__ import annotations
 from flask import Blueprint, jsonify, render_template, request
 
 from rover_web.core.state import current_feature
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import ApiError
 
 from .ring import LEVELS, parse_level
@@ -19,24 +20,29 @@ MAX_TEXT = 200
 def _query(args) -> dict:
     unknown = sorted(set(args) - {"level", "node", "contains", "limit"})
     if unknown:
-        raise ApiError(400, "unknown_parameter", f"unknown parameter {unknown[0][:40]!r}; "
-                       "use level, node, contains, limit")
+        raise ApiError(
+            400,
+            "unknown_parameter",
+            "unknown parameter %(unknown)s; use level, node, contains, limit",
+            unknown=repr(unknown[0][:40]),
+        )
     query = {"min_level": 0, "node": "", "contains": "", "limit": DEFAULT_LIMIT}
     if args.get("level"):
         try:
             query["min_level"] = parse_level(args["level"])
         except ValueError as exc:
-            raise ApiError(400, "bad_level", str(exc)) from None
+            raise ApiError(400, "bad_level", text_of(exc)) from None
     for key in ("node", "contains"):
         value = args.get(key, "")
         if len(value) > MAX_TEXT:
-            raise ApiError(400, f"bad_{key}", f"{key} is at most {MAX_TEXT} characters")
+            raise ApiError(400, "bad_" + key, "%(key)s is at most %(max_text)s characters", key=key, max_text=MAX_TEXT)
         query[key] = value
     if "limit" in args:
         keep = current_feature(RosoutLog).ring.keep
         raw = args["limit"]
         if not raw.isdigit() or not 1 <= int(raw) <= keep:
-            raise ApiError(400, "bad_limit", f"limit must be a whole number from 1 to {keep}, not {raw[:20]!r}")
+            raise ApiError(400, "bad_limit", "limit must be a whole number from 1 to %(keep)s, not %(raw)s",
+                           keep=keep, raw=repr(raw[:20]))
         query["limit"] = int(raw)
     return query
 

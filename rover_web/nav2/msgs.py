@@ -11,6 +11,7 @@ import importlib
 import importlib.util
 
 from rover_web.ros.convert import quaternion_from_yaw, stamp_to_float, yaw_from_quaternion
+from rover_web.web.api_messages import Text, explain
 
 # kind -> (action name under the robot's namespace, nav2_msgs/action type)
 ACTIONS = {"to_pose": ("navigate_to_pose", "NavigateToPose"),
@@ -43,7 +44,7 @@ LIFECYCLE_STATES = {0: "unknown", 1: "unconfigured", 2: "inactive", 3: "active",
 _error_names: dict[int, str] | None = None
 
 
-def missing(load: bool = False) -> str | None:
+def missing(load: bool = False) -> Text | None:
     """Why Nav2's actions cannot be used here (what is missing and how to get it), or None.
 
     At start only found, not loaded (`load=False`): a robot nobody navigates from the GUI does not
@@ -52,9 +53,9 @@ def missing(load: bool = False) -> str | None:
         if load:
             importlib.import_module("nav2_msgs.action")
         elif importlib.util.find_spec("nav2_msgs.action") is None:
-            return f"nav2_msgs is not installed. {HOW_TO_GET}"
+            return explain("nav2_msgs is not installed. %(how)s", how=HOW_TO_GET)
     except ImportError as exc:
-        return f"nav2_msgs could not be imported ({exc}). {HOW_TO_GET}"
+        return explain("nav2_msgs could not be imported (%(why)s). %(how)s", why=str(exc), how=HOW_TO_GET)
     return None
 
 

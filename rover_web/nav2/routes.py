@@ -10,6 +10,7 @@ from rover_web.geofence import OutsideGeofence
 from rover_web.livemap.keep_out import check_goal
 from rover_web.livemap.routes import answer_map_errors
 from rover_web.livemap.service import LiveMapService, OutsideMap, check_on_map
+from rover_web.web.api_messages import explain, text_of
 from rover_web.web.http import ApiError, error_response, json_body
 from rover_web.web.validate import InvalidInput, number, only_keys, text
 
@@ -22,22 +23,22 @@ ROUTE_MODES = {"through_poses": "through_poses", "follow_waypoints": "follow_way
 
 @bp.errorhandler(Nav2Unavailable)
 def unavailable(exc: Nav2Unavailable):
-    return error_response(503, exc.code, str(exc))
+    return error_response(503, exc.code, text_of(exc))
 
 
 @bp.errorhandler(GoalRejected)
 def rejected(exc: GoalRejected):
-    return error_response(409, "goal_rejected", str(exc))
+    return error_response(409, "goal_rejected", text_of(exc))
 
 
 @bp.errorhandler(NoGoal)
 def no_goal(exc: NoGoal):
-    return error_response(409, "no_goal", str(exc))
+    return error_response(409, "no_goal", text_of(exc))
 
 
 @bp.errorhandler(ShuttingDown)
 def shutting_down(exc: ShuttingDown):
-    return error_response(503, "shutting_down", str(exc))
+    return error_response(503, "shutting_down", text_of(exc))
 
 
 answer_map_errors(bp)  # a goal or route point off the map or in a keep-out area, as LiveMap answers it
@@ -49,12 +50,13 @@ def _sender() -> str:
 
 def _pose(item, where: str) -> tuple[float, float, float]:
     if not isinstance(item, dict):
-        raise InvalidInput(f"{where} must be an object {{\"x\": ..., \"y\": ..., \"yaw\": ...}}", "bad_type")
+        raise InvalidInput("%(where)s must be an object {\"x\": ..., \"y\": ..., \"yaw\": ...}", "bad_type",
+                           where=where)
     only_keys(item, {"x", "y", "yaw"})
     try:
         return number(item, "x"), number(item, "y"), number(item, "yaw", default=0.0)
     except InvalidInput as exc:
-        raise InvalidInput(f"{where}: {exc}", exc.code) from None
+        raise InvalidInput("%(where)s: %(why)s", exc.code, where=where, why=text_of(exc)) from None
 
 
 def _checked(map_name: str | None, poses: list[tuple[float, float, float]]) -> str:
@@ -72,7 +74,9 @@ def _checked(map_name: str | None, poses: list[tuple[float, float, float]]) -> s
             exc.details["index"] = i
             raise
         except OutsideMap as exc:
-            raise OutsideMap(f"pose {i}: {exc}" if len(poses) > 1 else str(exc)) from None
+            if len(poses) > 1:
+                raise OutsideMap(explain("pose %(i)s: %(why)s", i=i, why=text_of(exc))) from None
+            raise
     return definition.name
 
 
@@ -103,9 +107,9 @@ def post_goal():
         map_name = text(body, "map", max_len=200, default=None)
         pose = _pose({k: v for k, v in body.items() if k != "map"}, "the goal")
     except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, text_of(exc)) from None
     if service.missing is not None:  # after the body check: a bad request is told what is wrong with it first
-        raise Nav2Unavailable("nav2_unavailable", service.missing)
+        raise Nav2Unavailable("nav2_unavailable", service.missing_text)
     name = _checked(map_name, [pose])
     goal = service.send("to_pose", [pose], map_name=name, by=_sender(), watch=on_revoke)
     return jsonify(status="sent", goal=goal)
@@ -122,13 +126,13 @@ def post_route():
         mode = text(body, "mode", choices=tuple(ROUTE_MODES))
         raw = body.get("poses")
         if not isinstance(raw, list) or not 1 <= len(raw) <= service.max_poses:
-            raise InvalidInput(f"'poses' must be an array of 1 to {service.max_poses} poses",
-                               "missing_field" if raw is None else "bad_value")
+            raise InvalidInput("'poses' must be an array of 1 to %(max_poses)s poses",
+                               "missing_field" if raw is None else "bad_value", max_poses=service.max_poses)
         poses = [_pose(item, f"poses[{i}]") for i, item in enumerate(raw)]
     except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, text_of(exc)) from None
     if service.missing is not None:
-        raise Nav2Unavailable("nav2_unavailable", service.missing)
+        raise Nav2Unavailable("nav2_unavailable", service.missing_text)
     name = _checked(map_name, poses)
     goal = service.send(ROUTE_MODES[mode], poses, map_name=name, by=_sender(), watch=on_revoke)
     return jsonify(status="sent", goal=goal)
@@ -141,10 +145,10 @@ def post_cancel():
     try:
         only_keys(body or {}, set())
     except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, text_of(exc)) from None
     if service.missing is not None:
-        raise Nav2Unavailable("nav2_unavailable", service.missing)
+        raise Nav2Unavailable("nav2_unavailable", service.missing_text)
     goal = service.cancel_active("operator", f"canceled by {_sender()}")
     if goal is None:
-        raise NoGoal("no Nav2 goal sent from here is running")
+        raise NoGoal(explain("no Nav2 goal sent from here is running"))
     return jsonify(status="canceling", goal=goal)

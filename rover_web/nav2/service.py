@@ -20,6 +20,7 @@ from typing import Any
 
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
+from rover_web.web.api_messages import explain, text_of
 
 from . import msgs
 
@@ -103,6 +104,11 @@ class Nav2Service:
 
     # --- state ---
 
+    @property
+    def missing_text(self):
+        """Why Nav2 cannot be used (a Text, translated in an answer), or None."""
+        return self.missing
+
     def goal_via(self) -> str:
         """How LiveMap sends a goal now: 'action' (NavigateToPose) or 'topic' (ROVER_WEB_GOAL_TOPIC)."""
         if self.goal_mode == "topic":
@@ -121,7 +127,7 @@ class Nav2Service:
             lifecycle = [dict(v) for v in self._lifecycle.values()]
         return {
             "available": self.missing is None,
-            "missing": None if self.missing is None else {"packages": ["nav2_msgs"], "message": self.missing},
+            "missing": None if self.missing is None else {"packages": ["nav2_msgs"], "message": str(self.missing)},
             "goal_mode": self.goal_mode, "goal_via": self.goal_via(),
             "servers": {kind: {"action": name, "ready": bool(client and self.missing is None
                                                              and client.server_ready(name))}
@@ -141,9 +147,9 @@ class Nav2Service:
 
         `watch(close)` registers the request's credential with auth's revocation (on_revoke)."""
         if self.missing is not None:
-            raise Nav2Unavailable("nav2_unavailable", self.missing)
+            raise Nav2Unavailable("nav2_unavailable", self.missing_text)
         if self.rover.stopping.is_set():
-            raise ShuttingDown("the server is shutting down; no goal was sent")
+            raise ShuttingDown(explain("the server is shutting down; no goal was sent"))
         self.estop.check_motion()
         client = self.client()
         from rover_web.ros.goal_client import NoAnswer
@@ -195,15 +201,17 @@ class Nav2Service:
         if (not client.server_ready(self.actions[kind])
                 and time.monotonic() - (self._lifecycle_since or 0.0) > DISCOVERY_S):
             # Discovery has had its time: no server now is no Nav2, not a slow one (no 3 s wait per click).
-            raise Nav2Unavailable("no_nav2_server", f"no action server for {self.actions[kind]}: is Nav2 running "
-                                                    "(bt_navigator active)?")
+            raise Nav2Unavailable("no_nav2_server", explain("no action server for %(actions)s: is Nav2 running "
+                                                            "(bt_navigator active)?",
+                                                            actions=self.actions[kind]))
         try:
             sent = client.send_goal(msgs.action_type(kind), self.actions[kind], message, self.timeout_s,
                                     on_feedback, on_result)
         except NoAnswer as exc:
-            raise Nav2Unavailable("no_nav2_server", f"{exc}: is Nav2 running (bt_navigator active)?") from None
+            raise Nav2Unavailable("no_nav2_server", explain("%(why)s: is Nav2 running (bt_navigator active)?",
+                                                            why=text_of(exc))) from None
         if sent is None:
-            raise GoalRejected(f"{self.actions[kind]} rejected the goal")
+            raise GoalRejected(explain("%(actions)s rejected the goal", actions=self.actions[kind]))
         goal_id, handle = sent
         holder["id"] = goal_id
         record["id"] = goal_id

@@ -19,7 +19,7 @@ def overlays():
     summary = feature.summary()
     raw = request.args.get("costmaps", "0")
     if raw not in ("0", "1"):
-        raise ApiError(400, "bad_costmaps", f"costmaps must be 0 or 1, got {raw[:20]!r}")
+        raise ApiError(400, "bad_costmaps", "costmaps must be 0 or 1, got %(raw)s", raw=repr(raw[:20]))
     if raw == "1":
         summary["costmaps"] = feature.costmaps()
     return jsonify(summary)

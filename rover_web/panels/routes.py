@@ -6,6 +6,7 @@ from flask import Blueprint, abort, current_app, jsonify, render_template, reque
 
 from rover_web.auth import signed_in_name
 from rover_web.core.state import current_feature
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import ApiError, error_response, json_body
 
 from .service import CommandRefused, InvalidCommand, PanelError, PanelService, TooMany, UnknownControl, UnknownPanel
@@ -19,7 +20,7 @@ STATUS = {UnknownPanel: 404, UnknownControl: 404, InvalidCommand: 400, CommandRe
 
 @bp.errorhandler(PanelError)
 def panel_error(exc: PanelError):
-    response = error_response(STATUS[type(exc)], exc.code, str(exc))
+    response = error_response(STATUS[type(exc)], exc.code, text_of(exc))
     if isinstance(exc, TooMany):
         response.headers["Retry-After"] = str(max(1, int(exc.retry_after_s + 0.999)))
     return response
@@ -88,7 +89,8 @@ def get_log(panel_id: str):
     except ValueError:
         limit = -1
     if not 1 <= limit <= MAX_LOG_LIMIT:
-        raise ApiError(400, "bad_limit", f"limit must be an integer from 1 to {MAX_LOG_LIMIT}, got {raw[:20]!r}")
+        raise ApiError(400, "bad_limit", "limit must be an integer from 1 to %(max_log_limit)s, got %(raw)s",
+                       max_log_limit=MAX_LOG_LIMIT, raw=repr(raw[:20]))
     return jsonify(panel=panel_id, entries=svc.oplog.recent(panel_id, limit))
 
 
@@ -115,5 +117,5 @@ def command(panel_id: str, control_id: str):
     except ApiError as exc:
         if exc.status != 400:
             raise
-        body = InvalidCommand(exc.message, exc.code)  # still 404 first for an unknown control, then logged
+        body = InvalidCommand(exc.text, exc.code)  # still 404 first for an unknown control, then logged
     return jsonify(service().command(panel_id, control_id, body, _client()))

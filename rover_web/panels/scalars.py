@@ -12,6 +12,8 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
+from rover_web.web.api_messages import explain
+
 MAX_STRING_LENGTH = 1024
 
 FLOAT32_MAX = 3.4028234663852886e38
@@ -74,29 +76,42 @@ def coerce(stype: ScalarType, value: Any, *, low: float | None = None, high: flo
     high = stype.high if high is None else high
     if stype.kind == "bool":
         if not isinstance(value, bool):
-            raise InvalidValue(f"must be true or false for {stype.short}, got {describe(value)}", "bad_type")
+            raise InvalidValue(explain("must be true or false for %(short)s, got %(describe)s",
+                                       short=stype.short, describe=describe(value)), "bad_type")
         return value
     if stype.kind == "string":
         if not isinstance(value, str):
-            raise InvalidValue(f"must be a string for {stype.short}, got {describe(value)}", "bad_type")
+            raise InvalidValue(explain("must be a string for %(short)s, got %(describe)s",
+                                       short=stype.short, describe=describe(value)), "bad_type")
         if len(value) > max_length:
-            raise InvalidValue(f"must be at most {max_length} characters, got {len(value)}", "too_long")
+            raise InvalidValue(explain("must be at most %(max_length)s characters, got %(count)s",
+                                       max_length=max_length, count=len(value)), "too_long")
         return value
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         expected = "an integer" if stype.kind == "int" else "a number"
-        raise InvalidValue(f"must be {expected} for {stype.short}, got {describe(value)}", "bad_type")
+        raise InvalidValue(explain("must be %(expected)s for %(short)s, got %(describe)s",
+                                   expected=expected, short=stype.short, describe=describe(value)), "bad_type")
     if isinstance(value, float) and not math.isfinite(value):
-        raise InvalidValue(f"must be a finite number, got {value}", "non_finite")
+        raise InvalidValue(explain("must be a finite number, got %(value)s", value=value), "non_finite")
     if stype.kind == "int":
         if isinstance(value, float):
             if not value.is_integer():
-                raise InvalidValue(f"must be an integer for {stype.short}, got {value:g}", "bad_type")
+                raise InvalidValue(explain("must be an integer for %(short)s, got %(value)s",
+                                           short=stype.short, value=format(value, "g")), "bad_type")
             value = int(value)
     if value < low or value > high:  # before float(): an integer of hundreds of digits overflows it
         huge = isinstance(value, int) and abs(value) >= 10 ** 30
         shown = f"an integer of {len(str(abs(value)))} digits" if huge else number_text(value)
-        raise InvalidValue(f"must be from {number_text(low)} to {number_text(high)} for {stype.short}, got {shown}",
-                           "out_of_range")
+        raise InvalidValue(
+            explain(
+                "must be from %(number_text)s to %(number_text2)s for %(short)s, got %(shown)s",
+                number_text=number_text(low),
+                number_text2=number_text(high),
+                short=stype.short,
+                shown=shown,
+            ),
+            "out_of_range",
+        )
     return value if stype.kind == "int" else float(value)
 
 

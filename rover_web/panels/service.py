@@ -17,6 +17,7 @@ from typing import Any
 from rover_web.core.rate_limit import RateLimit
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
+from rover_web.web.api_messages import explain, text_of
 from rover_web.web.validate import InvalidInput, only_keys
 
 from . import msgs
@@ -142,15 +143,17 @@ class PanelService:
     def panel(self, panel_id: str) -> PanelState:
         state = self.states.get(panel_id)
         if state is None:
-            raise UnknownPanel(f"no panel {panel_id[:40]!r}; panels: {', '.join(self.specs)}", "unknown_panel")
+            raise UnknownPanel(explain("no panel %(panel_id)s; panels: %(specs)s",
+                                       panel_id=repr(panel_id[:40]), specs=', '.join(self.specs)), "unknown_panel")
         return state
 
     def unlock(self, panel_id: str, client: str) -> dict:
         state = self.panel(panel_id)
         wait = self.unlocks.hit(client)
         if wait:
-            raise TooMany(f"too many unlock attempts (ROVER_WEB_PANEL_UNLOCKS_PER_MIN); try again in "
-                          f"{max(1, int(wait + 0.999))} s", wait)
+            raise TooMany(explain("too many unlock attempts (ROVER_WEB_PANEL_UNLOCKS_PER_MIN); try again in "
+                                  "%(value)s s",
+                                  value=max(1, int(wait + 0.999))), wait)
         with state.lock:
             self._expire(state)
             state.unlock()
@@ -179,12 +182,20 @@ class PanelService:
         state = self.panel(panel_id)
         control = state.spec.control(control_id)
         if control is None:
-            raise UnknownControl(f"panel {panel_id!r} has no control {control_id[:40]!r}; controls: "
-                                 f"{', '.join(c.id for c in state.spec.controls)}", "unknown_control")
+            raise UnknownControl(
+                explain(
+                    "panel %(panel_id)s has no control %(control_id)s; controls: %(value)s",
+                    panel_id=repr(panel_id),
+                    control_id=repr(control_id[:40]),
+                    value=", ".join(c.id for c in state.spec.controls),
+                ),
+                "unknown_control",
+            )
         wait = self.refusals.retry_after_s(client)
         if wait:  # checked before anything is logged: a client hammering refusals writes nothing more
-            raise TooMany(f"too many refused commands (ROVER_WEB_PANEL_REFUSALS_PER_MIN); try again in "
-                          f"{max(1, int(wait + 0.999))} s", wait)
+            raise TooMany(explain("too many refused commands (ROVER_WEB_PANEL_REFUSALS_PER_MIN); try again in "
+                                  "%(value)s s",
+                                  value=max(1, int(wait + 0.999))), wait)
         if isinstance(body_or_error, InvalidCommand):
             self._refuse(state, control, None, "invalid", body_or_error, client)
         body = body_or_error
@@ -193,18 +204,22 @@ class PanelService:
             value = state.value_for(control, body)
             confirmed = body.get("confirmed", False)
             if not isinstance(confirmed, bool):
-                raise InvalidInput(f"'confirmed' must be true or false, got {type(confirmed).__name__}", "bad_type")
+                raise InvalidInput("'confirmed' must be true or false, got %(type)s", "bad_type",
+                                   type=type(confirmed).__name__)
         except (InvalidInput, InvalidValue) as exc:
-            self._refuse(state, control, body.get("value"), "invalid", InvalidCommand(str(exc), exc.code), client)
+            self._refuse(state, control, body.get("value"), "invalid", InvalidCommand(text_of(exc), exc.code), client)
         if control.confirm and not confirmed:
             self._refuse(state, control, value, "invalid", InvalidCommand(
-                f"{control.label} needs a confirmation: send {{\"confirmed\": true}} with the request",
+                explain("%(label)s needs a confirmation: send {\"confirmed\": true} with the request",
+                        label=control.label),
                 "confirmation_required"), client)
         with state.lock:
             self._expire(state)
             refusal = state.refusal(control)
             if refusal is not None:
-                self._refuse(state, control, value, "refused", CommandRefused(refusal.reason, refusal.code), client)
+                self._refuse(
+                    state, control, value, "refused", CommandRefused(refusal.reason_text, refusal.code), client
+                )
             self._publishers[control.topic].publish(msgs.scalar_message(control.type.name, value))
             state.renew()
             entry = self._record(panel_id, control.id, control.label, value, "sent", "", client)

@@ -13,6 +13,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from rover_web.web.api_messages import Text, explain, text_of
+
 from .scalars import InvalidValue, coerce
 from .spec import ControlSpec, DisplaySpec, PanelSpec
 
@@ -22,7 +24,11 @@ class Refusal:
     """Why a control cannot be used now: `code` is `locked` or `not_allowed`."""
 
     code: str
-    reason: str
+    reason: Text
+
+    @property
+    def reason_text(self) -> Text:
+        return self.reason
 
 
 def format_value(display: DisplaySpec, value: Any) -> str:
@@ -119,24 +125,44 @@ class PanelState:
         now = self._clock() if now is None else now
         with self._lock:
             if self._estop_engaged() and not control.allowed_during_estop:
-                return Refusal("estop_engaged", f"the e-stop is engaged: {control.label} is not sent until it is "
-                                                "released")
+                return Refusal("estop_engaged", explain("the e-stop is engaged: %(label)s is not sent until it is "
+                                                        "released",
+                                                        label=control.label))
             if control.requires_unlock and self.locked(now):
-                return Refusal("locked", f"the {self.spec.title} panel is locked; unlock it first")
+                return Refusal("locked", explain("the %(title)s panel is locked; unlock it first",
+                                                 title=self.spec.title))
             for display_id, allowed in control.enabled_when:
                 display = self.spec.display(display_id)
                 value, age, fresh = self.reading(display_id, now)
                 wanted = " or ".join(str(v) for v in allowed)
                 if age is None:
-                    return Refusal("not_allowed", f"{control.label} needs {display.label} to be {wanted}; "
-                                                  f"no {display.label} has been received yet")
+                    return Refusal("not_allowed", explain("%(label)s needs %(display)s to be %(wanted)s; no "
+                                                          "%(display)s has been received yet",
+                                                          label=control.label, display=display.label, wanted=wanted))
                 if not fresh:
-                    return Refusal("not_allowed", f"{control.label} needs {display.label} to be {wanted}; the last "
-                                                  f"{display.label} ({_format(value, display.digits)}) is "
-                                                  f"{age:.1f} s old")
+                    return Refusal(
+                        "not_allowed",
+                        explain(
+                            "%(label)s needs %(display)s to be %(wanted)s; the last "
+                            "%(display)s (%(value)s) is %(age)s s old",
+                            label=control.label,
+                            display=display.label,
+                            wanted=wanted,
+                            value=_format(value, display.digits),
+                            age=format(age, ".1f"),
+                        ),
+                    )
                 if not _matches(value, allowed):
-                    return Refusal("not_allowed", f"{control.label} is only allowed when {display.label} is {wanted}; "
-                                                  f"it is {_format(value, display.digits)}")
+                    return Refusal(
+                        "not_allowed",
+                        explain(
+                            "%(label)s is only allowed when %(display)s is %(wanted)s; it is %(value)s",
+                            label=control.label,
+                            display=display.label,
+                            wanted=wanted,
+                            value=_format(value, display.digits),
+                        ),
+                    )
         return None
 
     def value_for(self, control: ControlSpec, body: dict) -> Any:
@@ -144,12 +170,14 @@ class PanelState:
         if control.kind == "button":
             return control.value
         if "value" not in body or body["value"] is None:
-            raise InvalidValue(f"'value' is required: the {control.label} to send", "missing_field")
+            raise InvalidValue(
+                explain("'value' is required: the %(label)s to send", label=control.label), "missing_field"
+            )
         try:
             return coerce(control.type, body["value"], low=control.low, high=control.high,
                           max_length=control.max_length)
         except InvalidValue as exc:
-            raise InvalidValue(f"'value' {exc}", exc.code) from None
+            raise InvalidValue(explain("'value' %(why)s", why=text_of(exc)), exc.code) from None
 
     # --- views ---
 
@@ -174,7 +202,7 @@ class PanelState:
             controls = {}
             for c in self.spec.controls:
                 refusal = self.refusal(c, now)
-                controls[c.id] = {"enabled": refusal is None, "reason": refusal.reason if refusal else ""}
+                controls[c.id] = {"enabled": refusal is None, "reason": str(refusal.reason) if refusal else ""}
             return {"locked": self.locked(now), "light": self.light(now), "displays": displays, "controls": controls}
 
     def detail(self, now: float | None = None) -> dict:

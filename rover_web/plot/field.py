@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 import re
 
+from rover_web.web.api_messages import explain
+
 # \Z, not $: "$" also matches before a trailing newline.
 _SEGMENT = r"[A-Za-z_][A-Za-z0-9_]*(?:\[\d{1,6}\])*"
 PATH_RE = re.compile(rf"{_SEGMENT}(?:\.{_SEGMENT})*\Z")
@@ -25,7 +27,8 @@ class FieldError(ValueError):
 def parse_path(text: str) -> tuple[Step, ...]:
     """'pose.position[2]' -> ('pose', 'position', 2)."""
     if not text or len(text) > MAX_PATH_CHARS or not PATH_RE.match(text):
-        raise FieldError(f"field must be a path like twist.twist.linear.x or position[2], not {text[:40]!r}",
+        raise FieldError(explain("field must be a path like twist.twist.linear.x or position[2], not %(text)s",
+                                 text=repr(text[:40])),
                          "bad_field")
     return tuple(name if name else int(index) for name, index in _PART_RE.findall(text))
 

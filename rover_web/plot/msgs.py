@@ -6,6 +6,7 @@ import re
 
 from rover_web.ros.graph import deserializer
 from rover_web.ros.typesupport import UnknownMessageType, message_class
+from rover_web.web.api_messages import explain
 
 from .field import FieldError, Step
 
@@ -46,21 +47,27 @@ def numeric_kind(type_name: str, steps: tuple[Step, ...]) -> str:
         if isinstance(step, int):
             element = _element(current)
             if element is None:
-                raise FieldError(f"{where or 'the message'} is not an array, so [{step}] does not apply", "not_array")
+                raise FieldError(explain("%(value)s is not an array, so [%(step)s] does not apply",
+                                         value=where or 'the message', step=step), "not_array")
             current, size = element
             if size is not None and step >= size:
-                raise FieldError(f"{where} has {size} elements; [{step}] is beyond it", "no_such_field")
+                raise FieldError(explain("%(where)s has %(size)s elements; [%(step)s] is beyond it",
+                                         where=where, size=size, step=step), "no_such_field")
             where += f"[{step}]"
             continue
         if _element(current) is not None:
-            raise FieldError(f"{where} is an array: give an index, e.g. {where}[0]", "not_numeric")
+            raise FieldError(
+                explain("%(where)s is an array: give an index, e.g. %(where)s[0]", where=where), "not_numeric"
+            )
         fields = _fields(current)
         if fields is None or step not in fields:
-            raise FieldError(f"{type_name} has no field {(where + '.' if where else '') + step}", "no_such_field")
+            raise FieldError(explain("%(type_name)s has no field %(value)s",
+                                     type_name=type_name, value=(where + '.' if where else '') + step), "no_such_field")
         current = fields[step]
         where = f"{where}.{step}" if where else step
     if _element(current) is not None or current not in NUMERIC:
-        raise FieldError(f"{where} of {type_name} is {current}, not a number", "not_numeric")
+        raise FieldError(explain("%(where)s of %(type_name)s is %(current)s, not a number",
+                                 where=where, type_name=type_name, current=current), "not_numeric")
     return current
 
 

@@ -10,6 +10,7 @@ from flask import Blueprint, jsonify, render_template, request
 from rover_web.core.state import current_feature
 from rover_web.topics.routes import STATUS as ECHO_STATUS
 from rover_web.topics.service import EchoRefused, TopicBrowser
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import ApiError
 from rover_web.web.streams import client_key, refuse_cross_site
 from rover_web.web.validate import InvalidInput
@@ -27,14 +28,14 @@ DEFAULT_SECONDS = 60.0
 def _refused(exc: EchoRefused) -> ApiError:
     """The topic browser's refusal, with the status the topic browser answers it with (its subclasses too)."""
     status = next((ECHO_STATUS[cls] for cls in type(exc).__mro__ if cls in ECHO_STATUS), 503)
-    return ApiError(status, exc.code, str(exc))
+    return ApiError(status, exc.code, text_of(exc))
 
 
 def _topic_key(args) -> tuple[str, str]:
     try:
         return current_feature(TopicBrowser).resolve(args)
     except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, text_of(exc)) from None
     except EchoRefused as exc:
         raise _refused(exc) from None
 
@@ -48,8 +49,13 @@ def _seconds(args) -> float:
     except ValueError:
         seconds = math.nan
     if not math.isfinite(seconds) or not 0 < seconds <= MAX_SECONDS:
-        raise ApiError(400, "bad_seconds", f"seconds must be a number above 0 and at most {MAX_SECONDS:.0f}, "
-                       f"not {raw[:20]!r}")
+        raise ApiError(
+            400,
+            "bad_seconds",
+            "seconds must be a number above 0 and at most %(max_seconds)s, not %(raw)s",
+            max_seconds=format(MAX_SECONDS, ".0f"),
+            raw=repr(raw[:20]),
+        )
     return seconds
 
 
@@ -64,11 +70,11 @@ def api_plot():
     try:
         series = plots.series(key, field, client_key())
     except NotPlottable as exc:
-        raise ApiError(422, "not_plottable", str(exc)) from None
+        raise ApiError(422, "not_plottable", text_of(exc)) from None
     except FieldError as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, text_of(exc)) from None
     except TooManySeries as exc:
-        raise ApiError(503, "too_many_series", str(exc)) from None
+        raise ApiError(503, "too_many_series", text_of(exc)) from None
     except EchoRefused as exc:
         raise _refused(exc) from None
     t, v, decimated = series.ring.window(time.time() - seconds)
@@ -84,7 +90,7 @@ def api_plot_fields():
     try:
         check_plottable(type_name)
     except NotPlottable as exc:
-        raise ApiError(422, "not_plottable", str(exc)) from None
+        raise ApiError(422, "not_plottable", text_of(exc)) from None
     return jsonify({"topic": topic, "type": type_name, "fields": msgs.numeric_paths(type_name)})
 
 

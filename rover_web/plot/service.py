@@ -16,6 +16,7 @@ from collections import deque
 
 from rover_web.core.state import Rover
 from rover_web.topics.service import TopicBrowser
+from rover_web.web.api_messages import explain
 
 from . import msgs
 from .field import FieldError, finite, parse_path, read_number
@@ -90,8 +91,9 @@ class _PlotTopic:
 
 def check_plottable(type_name: str) -> None:
     if type_name in NOT_PLOTTABLE:
-        raise NotPlottable(f"{type_name} is bulk data (images, point clouds, maps), not numbers to plot; "
-                           "plot a topic of numbers, or view it in the camera or topic pages")
+        raise NotPlottable(explain("%(type_name)s is bulk data (images, point clouds, maps), not numbers to plot; "
+                                   "plot a topic of numbers, or view it in the camera or topic pages",
+                                   type_name=type_name))
 
 
 def oversize(plots: Plots, key: tuple[str, str]) -> int:
@@ -138,15 +140,17 @@ class Plots:
             if client is not None and (series is None or client not in series.users):
                 held = self._held_by(client, now)
                 if held >= self.per_client:
-                    raise TooManySeries(f"you plot {held} series already (ROVER_WEB_PLOT_SERIES_PER_CLIENT): "
-                                        f"close one, or wait {self.idle_s:g} s after you stop asking for it")
+                    raise TooManySeries(explain("you plot %(held)s series already "
+                                                "(ROVER_WEB_PLOT_SERIES_PER_CLIENT): close one, or wait %(idle_s)s "
+                                                "s after you stop asking for it",
+                                                held=held, idle_s=format(self.idle_s, "g")))
             if series is not None:
                 series.used_at = now
                 if client is not None:
                     series.users[client] = now
                 return series
             if sum(len(p.series) for p in self._topics.values()) >= MAX_SERIES:
-                raise TooManySeries(f"{MAX_SERIES} series are plotted already")
+                raise TooManySeries(explain("%(max_series)s series are plotted already", max_series=MAX_SERIES))
             if plot_topic is None:
                 echo = self.browser.acquire(key)
                 plot_topic = self._topics[key] = _PlotTopic(key, echo, self.max_message_bytes)

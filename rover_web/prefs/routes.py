@@ -6,6 +6,7 @@ from flask import Blueprint, jsonify
 
 from rover_web.auth.identity import signed_in_name
 from rover_web.core.state import current_feature
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import ApiError, error_response, json_body
 from rover_web.web.validate import InvalidInput
 
@@ -34,4 +35,4 @@ def set_preferences():
 
 @bp.errorhandler(InvalidInput)
 def _invalid(exc: InvalidInput):
-    return error_response(400, exc.code, str(exc))
+    return error_response(400, exc.code, text_of(exc))

@@ -37,11 +37,14 @@ def check(body: dict) -> dict:
     for key, value in body.items():
         allowed = ALLOWED.get(key)
         if allowed is None:
-            raise InvalidInput(f"unknown field {key!r}; allowed: {', '.join(ALLOWED)}", "unknown_field")
+            raise InvalidInput("unknown field %(key)s; allowed: %(allowed)s", "unknown_field",
+                               key=repr(key), allowed=', '.join(ALLOWED))
         if not isinstance(value, str):
-            raise InvalidInput(f"'{key}' must be a string, one of: {', '.join(allowed)}", "bad_type")
+            raise InvalidInput("'%(key)s' must be a string, one of: %(allowed)s", "bad_type",
+                               key=key, allowed=', '.join(allowed))
         if value not in allowed:
-            raise InvalidInput(f"'{key}' must be one of: {', '.join(allowed)} (not {value[:40]!r})", "bad_value")
+            raise InvalidInput("'%(key)s' must be one of: %(allowed)s (not %(value)s)", "bad_value",
+                               key=key, allowed=', '.join(allowed), value=repr(value[:40]))
         changes[key] = value
     return changes
 

@@ -31,6 +31,8 @@ from mcap.data_stream import ReadDataStream
 from mcap.opcode import Opcode
 from mcap.records import Channel, Footer, Message, Schema
 
+from rover_web.web.api_messages import Text, explain
+
 from .reading import Refused
 
 MIB = 1 << 20
@@ -69,23 +71,40 @@ class Budget:
     def spend(self, nbytes: int) -> None:
         self.decompressed += nbytes
         if self.decompressed > self.most:
-            raise TooCostly("read_budget", f"reading this file would decompress more than {self.most // MIB} MB "
-                                           f"(at most {READ_RATIO} times the file's size, or {READ_MIN // MIB} MB): "
-                                           f"refused")
+            raise TooCostly(
+                "read_budget",
+                explain(
+                    "reading this file would decompress more than %(value)s MB (at "
+                    "most %(read_ratio)s times the file's size, or %(value2)s MB): "
+                    "refused",
+                    value=self.most // MIB,
+                    read_ratio=READ_RATIO,
+                    value2=READ_MIN // MIB,
+                ),
+            )
         self.check_time()
 
     def check_time(self) -> None:
         if time.monotonic() - self.started > TIME_S:
-            raise TooCostly("time_budget", f"reading this file took more than {TIME_S:g} s: refused")
+            raise TooCostly("time_budget", explain("reading this file took more than %(time_s)s s: refused",
+                                                   time_s=format(TIME_S, "g")))
 
 
 def check_schema(schema: Schema) -> None:
     if len(schema.data) > SCHEMA_MAX:
-        raise TooCostly("schema_too_large", f"schema {schema.name[:80]!r} is {len(schema.data)} bytes, more than "
-                                            f"{SCHEMA_MAX}")
+        raise TooCostly(
+            "schema_too_large",
+            explain(
+                "schema %(name)s is %(count)s bytes, more than %(schema_max)s",
+                name=repr(schema.name[:80]),
+                count=len(schema.data),
+                schema_max=SCHEMA_MAX,
+            ),
+        )
     if schema.data.count(b"\n") + 1 > SCHEMA_FIELDS and _fields(schema.data) > SCHEMA_FIELDS:
-        raise TooCostly("schema_too_many_fields", f"schema {schema.name[:80]!r} declares more than {SCHEMA_FIELDS} "
-                                                  f"fields")
+        raise TooCostly("schema_too_many_fields", explain("schema %(name)s declares more than %(schema_fields)s "
+                                                          "fields",
+                                                          name=repr(schema.name[:80]), schema_fields=SCHEMA_FIELDS))
 
 
 def _fields(text: bytes) -> int:
@@ -97,19 +116,20 @@ def _fields(text: bytes) -> int:
     return count
 
 
-def _refuse_chunk(declared: int, held: str) -> TooCostly:
-    return TooCostly("chunk_too_large", f"a chunk {held}; a chunk may hold at most {CHUNK_MAX // MIB} MB "
-                                        f"(it declares {declared} bytes)")
+def _refuse_chunk(declared: int, held: Text) -> TooCostly:
+    return TooCostly("chunk_too_large", explain("a chunk %(held)s; a chunk may hold at most %(value)s MB (it "
+                                                "declares %(declared)s bytes)",
+                                                held=held, value=CHUNK_MAX // MIB, declared=declared))
 
 
 def decompress(compression: str, data: bytes, declared: int) -> bytes | bytearray:
     """The chunk's content, never more than min(declared, CHUNK_MAX) bytes made."""
     if declared > CHUNK_MAX:
-        raise _refuse_chunk(declared, f"declares {declared // MIB} MB")
+        raise _refuse_chunk(declared, explain("declares %(mb)s MB", mb=declared // MIB))
     most = declared
     if compression == "":
         if len(data) != declared:
-            raise Refused("corrupt", "an uncompressed chunk's length is not the size it declares")
+            raise Refused("corrupt", explain("an uncompressed chunk's length is not the size it declares"))
         return data
     if compression == "zstd":
         import zstandard
@@ -125,7 +145,7 @@ def decompress(compression: str, data: bytes, declared: int) -> bytes | bytearra
                 filled += n
         view.release()
         if filled > most:
-            raise _refuse_chunk(declared, "holds more than it declares")
+            raise _refuse_chunk(declared, explain("holds more than it declares"))
         del out[filled:]
         return out
     if compression == "lz4":
@@ -134,9 +154,10 @@ def decompress(compression: str, data: bytes, declared: int) -> bytes | bytearra
         decompressor = lz4.frame.LZ4FrameDecompressor()
         out = decompressor.decompress(data, max_length=most + 1)
         if len(out) > most or (not decompressor.eof and not decompressor.needs_input):
-            raise _refuse_chunk(declared, "holds more than it declares")
+            raise _refuse_chunk(declared, explain("holds more than it declares"))
         return out
-    raise Refused("corrupt", f"a chunk is compressed with {compression[:20]!r}, which this server does not read")
+    raise Refused("corrupt", explain("a chunk is compressed with %(compression)s, which this server does not read",
+                                     compression=repr(compression[:20])))
 
 
 def read_chunk(f, offset: int, file_size: int, budget: Budget) -> bytes:
@@ -145,18 +166,19 @@ def read_chunk(f, offset: int, file_size: int, budget: Budget) -> bytes:
     f.seek(offset)
     head = f.read(_HEAD.size)
     if len(head) < _HEAD.size:
-        raise Refused("corrupt", f"no record at byte {offset}")
+        raise Refused("corrupt", explain("no record at byte %(offset)s", offset=offset))
     opcode, length = _HEAD.unpack(head)
     if opcode != Opcode.CHUNK:
-        raise Refused("corrupt", f"the record at byte {offset} is not a chunk (opcode {opcode:#x})")
+        raise Refused("corrupt", explain("the record at byte %(offset)s is not a chunk (opcode %(opcode)s)",
+                                         offset=offset, opcode=format(opcode, "#x")))
     return _chunk_content(f, offset + _HEAD.size, length, file_size, budget)
 
 
 def _chunk_content(f, at: int, length: int, file_size: int, budget: Budget) -> bytes:
     if at + length > file_size:
-        raise Refused("truncated", "a chunk runs past the end of the file")
+        raise Refused("truncated", explain("a chunk runs past the end of the file"))
     if length > CHUNK_MAX + 1024:
-        raise _refuse_chunk(-1, f"is {length // MIB} MB compressed")
+        raise _refuse_chunk(-1, explain("is %(mb)s MB compressed", mb=length // MIB))
     f.seek(at)
     record = f.read(length)
     try:
@@ -166,17 +188,17 @@ def _chunk_content(f, at: int, length: int, file_size: int, budget: Budget) -> b
         data_length = stream.read8()
         data = record[_CHUNK_HEAD.size + 4 + len(compression.encode()) + 8:]
     except (struct.error, UnicodeDecodeError, EOFError, ValueError):
-        raise Refused("corrupt", "a chunk's header is damaged") from None
+        raise Refused("corrupt", explain("a chunk's header is damaged")) from None
     if data_length != len(data):
-        raise Refused("corrupt", "a chunk's data length does not match its record")
+        raise Refused("corrupt", explain("a chunk's data length does not match its record"))
     if declared > CHUNK_MAX:
-        raise _refuse_chunk(declared, f"declares {declared // MIB} MB")
+        raise _refuse_chunk(declared, explain("declares %(mb)s MB", mb=declared // MIB))
     budget.spend(declared)
     content = decompress(compression, data, declared)
     if len(content) != declared:
-        raise Refused("corrupt", "a chunk holds less than the size it declares")
+        raise Refused("corrupt", explain("a chunk holds less than the size it declares"))
     if crc and zlib.crc32(content) != crc:
-        raise Refused("corrupt", "a chunk's CRC does not match its content")
+        raise Refused("corrupt", explain("a chunk's CRC does not match its content"))
     return content
 
 
@@ -201,11 +223,11 @@ def parse_records(content: bytes, wanted: Callable[[int], bool] | None = None,
     seen = 0
     while at < end:
         if end - at < _HEAD.size:
-            raise Refused("corrupt", "a chunk ends inside a record's header")
+            raise Refused("corrupt", explain("a chunk ends inside a record's header"))
         opcode, length = _HEAD.unpack_from(content, at)
         at += _HEAD.size
         if at + length > end:
-            raise Refused("corrupt", "a record runs past the end of its chunk")
+            raise Refused("corrupt", explain("a record runs past the end of its chunk"))
         if opcode == Opcode.MESSAGE:
             yield message_of(view, at, length, wanted)
         elif opcode == Opcode.SCHEMA:
@@ -220,10 +242,11 @@ def parse_records(content: bytes, wanted: Callable[[int], bool] | None = None,
 
 def message_of(view, at: int, length: int, wanted: Callable[[int], bool] | None) -> Message:
     if length < _MESSAGE_HEAD.size:
-        raise Refused("corrupt", "a message record is shorter than its header")
+        raise Refused("corrupt", explain("a message record is shorter than its header"))
     size = length - _MESSAGE_HEAD.size
     if size > MESSAGE_MAX:
-        raise TooCostly("message_too_large", f"a message is {size // MIB} MB, more than {MESSAGE_MAX // MIB} MB")
+        raise TooCostly("message_too_large", explain("a message is %(value)s MB, more than %(value2)s MB",
+                                                     value=size // MIB, value2=MESSAGE_MAX // MIB))
     channel, sequence, log_time, publish_time = _MESSAGE_HEAD.unpack_from(view, at)
     data = bytes(view[at + _MESSAGE_HEAD.size:at + length]) if wanted is None or wanted(channel) else b""
     return Message(channel_id=channel, sequence=sequence, log_time=log_time, publish_time=publish_time, data=data)
@@ -233,7 +256,7 @@ def schema_of(record: bytes) -> Schema:
     try:
         schema = Schema.read(ReadDataStream(_View(record, 0)))
     except (struct.error, UnicodeDecodeError, EOFError, ValueError):
-        raise Refused("corrupt", "a schema record is damaged") from None
+        raise Refused("corrupt", explain("a schema record is damaged")) from None
     check_schema(schema)
     return schema
 
@@ -265,10 +288,12 @@ def records(f, file_size: int, budget: Budget, wanted: Callable[[int], bool] | N
                 yield Located(record, at)
         elif opcode in (Opcode.SCHEMA, Opcode.CHANNEL, Opcode.MESSAGE):
             if opcode == Opcode.MESSAGE and length > MESSAGE_MAX + _MESSAGE_HEAD.size:
-                raise TooCostly("message_too_large", f"a message is {length // MIB} MB, more than "
-                                                     f"{MESSAGE_MAX // MIB} MB")
+                raise TooCostly("message_too_large", explain("a message is %(value)s MB, more than %(value2)s MB",
+                                                             value=length // MIB, value2=MESSAGE_MAX // MIB))
             if opcode == Opcode.SCHEMA and length > SCHEMA_MAX + 1024:
-                raise TooCostly("schema_too_large", f"a schema record is {length} bytes, more than {SCHEMA_MAX}")
+                raise TooCostly("schema_too_large", explain("a schema record is %(length)s bytes, more than "
+                                                            "%(schema_max)s",
+                                                            length=length, schema_max=SCHEMA_MAX))
             raw = f.read(length)
             if opcode == Opcode.MESSAGE:
                 yield Located(message_of(memoryview(raw), 0, length, wanted), None)

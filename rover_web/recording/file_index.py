@@ -31,6 +31,8 @@ from mcap.exceptions import McapError
 from mcap.records import Channel, Footer, Message, Schema
 from mcap_ros2.decoder import DecoderFactory
 
+from rover_web.web.api_messages import explain
+
 from . import bounds
 from .bounds import Budget, TooCostly
 from .reading import MAGIC, NotARecording, Refused, cut_or_damaged, read_messages
@@ -233,12 +235,14 @@ def walk(path: Path, strict: bool = False) -> FileIndex:
         size = path.stat().st_size
         with open(path, "rb") as f:
             if f.read(len(MAGIC)) != MAGIC:
-                raise Refused("not_mcap", "this is not an MCAP file (it does not start with the MCAP magic bytes)")
+                raise Refused("not_mcap", explain("this is not an MCAP file (it does not start with the MCAP magic "
+                                                  "bytes)"))
             ends_well = _ends_with_magic(f)
             if strict and not ends_well:
-                raise Refused("truncated", "the file is cut short: it does not end with MCAP's closing magic bytes "
-                                           "(a copy or download that stopped early, or a recording cut by a crash; "
-                                           "`mcap recover` rewrites such a file whole)")
+                raise Refused("truncated", explain("the file is cut short: it does not end with MCAP's closing "
+                                                   "magic bytes (a copy or download that stopped early, or a "
+                                                   "recording cut by a crash; `mcap recover` rewrites such a file "
+                                                   "whole)"))
             index = FileIndex(path, complete=False)
             try:
                 _walk_records(f, size, index)
@@ -246,16 +250,24 @@ def walk(path: Path, strict: bool = False) -> FileIndex:
                 raise
             except cut_or_damaged() as exc:
                 if strict:
-                    raise Refused("corrupt", f"the file is damaged at byte {f.tell()} "
-                                             f"({type(exc).__name__}: {str(exc)[:120]})") from None
+                    raise Refused(
+                        "corrupt",
+                        explain(
+                            "the file is damaged at byte %(tell)s (%(type)s: %(why)s)",
+                            tell=f.tell(),
+                            type=type(exc).__name__,
+                            why=str(exc)[:120],
+                        ),
+                    ) from None
                 if not index.channels:
-                    raise NotARecording(f"{path} is damaged before its first message ({type(exc).__name__})") \
+                    raise NotARecording(explain("%(path)s is damaged before its first message (%(type)s)",
+                                                path=path, type=type(exc).__name__)) \
                         from None
             if strict and not index.complete:
-                raise Refused("truncated", "the file is cut short: its records stop before the footer")
+                raise Refused("truncated", explain("the file is cut short: its records stop before the footer"))
             return index
     except OSError as exc:
-        raise NotARecording(f"cannot read {path}: {exc.strerror or exc}") from None
+        raise NotARecording(explain("cannot read %(path)s: %(value)s", path=path, value=exc.strerror or exc)) from None
 
 
 def _ends_with_magic(f) -> bool:
@@ -329,7 +341,7 @@ def index_of(path: Path, trust_summary: bool = False) -> FileIndex:
     try:
         key = _key(path)
     except OSError as exc:
-        raise NotARecording(f"cannot read {path}: {exc.strerror or exc}") from None
+        raise NotARecording(explain("cannot read %(path)s: %(value)s", path=path, value=exc.strerror or exc)) from None
     with _cache_lock:
         if key in _cache:
             _cache.move_to_end(key)

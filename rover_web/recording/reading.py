@@ -18,6 +18,8 @@ from pathlib import Path
 from mcap.exceptions import EndOfFile, InvalidMagic, McapError
 from mcap.records import Channel, Footer, Message, Schema
 
+from rover_web.web.api_messages import explain
+
 MAGIC = b"\x89MCAP0\r\n"
 
 
@@ -62,7 +64,9 @@ def read_messages(path: Path, outcome: Outcome | None = None) -> Iterator[tuple[
     try:
         with open(path, "rb") as f:
             if f.read(len(MAGIC)) != MAGIC:
-                raise NotARecording(f"{path} is not an MCAP file (it does not start with the MCAP magic bytes)")
+                raise NotARecording(explain("%(path)s is not an MCAP file (it does not start with the MCAP magic "
+                                            "bytes)",
+                                            path=path))
             size = f.seek(0, 2)
             schemas: dict[int, Schema] = {}
             channels: dict[int, Channel] = {}
@@ -82,13 +86,14 @@ def read_messages(path: Path, outcome: Outcome | None = None) -> Iterator[tuple[
                     elif isinstance(record, Footer):
                         outcome.complete = True
                 if not outcome.complete and outcome.messages == 0 and not channels:
-                    raise NotARecording(f"{path} is cut before its first message")
+                    raise NotARecording(explain("%(path)s is cut before its first message", path=path))
             except TooCostly:
                 raise
             except cut_or_damaged() as exc:
                 if outcome.messages == 0 and not channels:
-                    raise NotARecording(f"{path} is damaged before its first message ({type(exc).__name__})") \
+                    raise NotARecording(explain("%(path)s is damaged before its first message (%(type)s)",
+                                                path=path, type=type(exc).__name__)) \
                         from None
                 # Cut short: what came before is what survived.
     except OSError as exc:
-        raise NotARecording(f"cannot read {path}: {exc.strerror or exc}") from None
+        raise NotARecording(explain("cannot read %(path)s: %(value)s", path=path, value=exc.strerror or exc)) from None

@@ -24,6 +24,7 @@ from rover_web.diagnostics.board import DiagnosticsBoard
 from rover_web.diagnostics.msgs import DIAGNOSTIC_ARRAY, statuses
 from rover_web.plot.field import finite, parse_path, read_number
 from rover_web.plot.service import NOT_PLOTTABLE
+from rover_web.web.api_messages import explain
 
 from .file_index import FileIndex, stride_for
 from .timeline import decode_sampled
@@ -78,7 +79,8 @@ def _file_key(index: FileIndex) -> tuple:
 def _need(index: FileIndex, topic: str) -> str:
     type_name = index.type_of(topic)
     if type_name is None or not index.count([topic]):
-        raise NotShown("unknown_topic", f"this recording holds no message on {topic[:120]!r}")
+        raise NotShown("unknown_topic", explain("this recording holds no message on %(topic)s",
+                                                topic=repr(topic[:120])))
     return type_name
 
 
@@ -89,13 +91,15 @@ def fields(index: FileIndex, topic: str) -> dict:
     """The numeric field paths of the topic's messages, read from its first message."""
     type_name = _need(index, topic)
     if type_name in NOT_PLOTTABLE:
-        raise NotShown("not_plottable", f"{topic} is {type_name}: bulk data, not numbers to plot")
+        raise NotShown("not_plottable", explain("%(topic)s is %(type_name)s: bulk data, not numbers to plot",
+                                                topic=topic, type_name=type_name))
     sample = None
     for _channel, message in index.messages([topic]):
         sample = index.decode(message)
         break
     if sample is None:
-        raise NotShown("not_decodable", f"{topic}'s messages cannot be decoded (type {type_name or 'unknown'})")
+        raise NotShown("not_decodable", explain("%(topic)s's messages cannot be decoded (type %(value)s)",
+                                                topic=topic, value=type_name or 'unknown'))
     out: list[str] = []
     _numeric_paths(sample, "", 6, out)
     return {"topic": topic, "type": type_name, "fields": out}
@@ -122,7 +126,8 @@ def series(index: FileIndex, topic: str, field_paths: list[str]) -> dict:
     leaves it out). FieldError (plot/field.py) for a malformed path."""
     type_name = _need(index, topic)
     if type_name in NOT_PLOTTABLE:
-        raise NotShown("not_plottable", f"{topic} is {type_name}: bulk data, not numbers to plot")
+        raise NotShown("not_plottable", explain("%(topic)s is %(type_name)s: bulk data, not numbers to plot",
+                                                topic=topic, type_name=type_name))
     steps = {f: parse_path(f) for f in field_paths}
     return _series.get((_file_key(index), topic, tuple(field_paths)), lambda: _read_series(index, topic, steps))
 
@@ -222,7 +227,9 @@ def frame_at(index: FileIndex, topic: str, t: float, quality: int, width: int | 
     frame. A frame that cannot be shown is an error frame saying why, as on the live camera."""
     type_name = _need(index, topic)
     if type_name not in IMAGE_TYPES:
-        raise NotShown("not_an_image", f"{topic} is {type_name}, not sensor_msgs/Image or CompressedImage")
+        raise NotShown("not_an_image", explain("%(topic)s is %(type_name)s, not sensor_msgs/Image or "
+                                               "CompressedImage",
+                                               topic=topic, type_name=type_name))
     found = index.latest(topic, int(math.floor(t * 1e9)))
     if found is None:
         return None

@@ -13,6 +13,7 @@ from flask import Response, jsonify, render_template, request
 
 from rover_web.core.state import current_feature
 from rover_web.plot.field import FieldError
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import ApiError, accepts_media, body_limit, error_response
 from rover_web.web.validate import InvalidInput, topic_name
 
@@ -35,16 +36,16 @@ def _readable(recording_id: str) -> FileIndex:
         # A summary is believed only in a file this server recorded itself (bounds.py, issue 40).
         return index_of(service.path_of(recording_id), trust_summary=status["source"] == "recorded")
     except Refused as exc:
-        raise ApiError(422, exc.code, str(exc)) from None
+        raise ApiError(422, exc.code, text_of(exc)) from None
     except NotARecording as exc:
-        raise ApiError(422, "not_a_recording", str(exc)) from None
+        raise ApiError(422, "not_a_recording", text_of(exc)) from None
 
 
 def _topic() -> str:
     try:
         return topic_name(request.args.get("topic"), "topic")
     except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, text_of(exc)) from None
 
 
 def _time() -> float:
@@ -54,8 +55,8 @@ def _time() -> float:
     except ValueError:
         t = math.nan
     if not math.isfinite(t) or not 0 <= t < 1e11:
-        raise ApiError(400, "bad_time", f"t is the time to show, in seconds since the epoch (as the timeline's "
-                                        f"start and end), not {raw[:30]!r}")
+        raise ApiError(400, "bad_time", "t is the time to show, in seconds since the epoch (as the timeline's start "
+                                        "and end), not %(raw)s", raw=repr(raw[:30]))
     return t
 
 
@@ -64,18 +65,19 @@ def _int_arg(name: str, code: str, low: int, high: int, default: int | None) -> 
     if raw is None or raw == "":
         return default
     if not raw.isdigit() or not low <= int(raw) <= high:
-        raise ApiError(400, code, f"{name} is a whole number from {low} to {high}, not {raw[:20]!r}")
+        raise ApiError(400, code, "%(name)s is a whole number from %(low)s to %(high)s, not %(raw)s",
+                       name=name, low=low, high=high, raw=repr(raw[:20]))
     return int(raw)
 
 
 @bp.errorhandler(Refused)
 def _refused(exc: Refused):
     """A file over one of bounds.py's bounds, met while answering (a chunk the index did not open)."""
-    return error_response(422, exc.code, str(exc))
+    return error_response(422, exc.code, text_of(exc))
 
 
 def _not_shown(exc: replay_data.NotShown) -> ApiError:
-    return ApiError(404 if exc.code == "unknown_topic" else 422, exc.code, str(exc))
+    return ApiError(404 if exc.code == "unknown_topic" else 422, exc.code, text_of(exc))
 
 
 @bp.get("/recordings/<recording_id>/replay")
@@ -111,9 +113,9 @@ def recording_timeline(recording_id: str):
     try:
         return jsonify(id=recording_id, **timeline_of(index))
     except Refused as exc:
-        raise ApiError(422, exc.code, str(exc)) from None
+        raise ApiError(422, exc.code, text_of(exc)) from None
     except NotARecording as exc:
-        raise ApiError(422, "not_a_recording", str(exc)) from None
+        raise ApiError(422, "not_a_recording", text_of(exc)) from None
 
 
 @bp.get("/api/recordings/<recording_id>/fields")
@@ -131,12 +133,12 @@ def recording_series(recording_id: str):
     topic = _topic()
     fields = request.args.getlist("field")
     if not 1 <= len(fields) <= replay_data.MAX_FIELDS or len(set(fields)) != len(fields):
-        raise ApiError(400, "bad_field", f"give 1 to {replay_data.MAX_FIELDS} different fields "
-                                         f"(field=pose.pose.position.x&field=...)")
+        raise ApiError(400, "bad_field", "give 1 to %(max_fields)s different fields "
+                                         "(field=pose.pose.position.x&field=...)", max_fields=replay_data.MAX_FIELDS)
     try:
         return jsonify(replay_data.series(index, topic, fields))
     except FieldError as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, text_of(exc)) from None
     except replay_data.NotShown as exc:
         raise _not_shown(exc) from None
 
@@ -179,7 +181,8 @@ def recording_frame(recording_id: str):
 def upload_recording():
     name = request.args.get("name", "").strip()
     if len(name) > MAX_NAME or any(ord(c) < 32 for c in name):
-        raise ApiError(400, "bad_name", f"'name' is text of at most {MAX_NAME} characters, on one line")
+        raise ApiError(400, "bad_name", "'name' is text of at most %(max_name)s characters, on one line",
+                       max_name=MAX_NAME)
     status = upload.receive(_service(), request, name, _by())
     response = jsonify(status)
     response.status_code = 201

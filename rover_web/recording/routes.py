@@ -10,6 +10,7 @@ from flask import Blueprint, jsonify, render_template, request, send_file
 
 from rover_web.auth import signed_in_name
 from rover_web.core.state import current_feature
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import ApiError, json_body
 from rover_web.web.validate import InvalidInput, only_keys, topic_name
 
@@ -41,18 +42,19 @@ def parse_selection(body: dict) -> Selection:
     try:
         only_keys(body, {"topics", "camera", "name"})
     except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, text_of(exc)) from None
     topics = body.get("topics", "all")
     if isinstance(topics, str):
         if topics != "all" and not (topics.startswith("preset:") and len(topics) > len("preset:")):
             raise ApiError(400, "bad_topics", "'topics' is \"all\", \"preset:NAME\" or a list of topic names")
     elif isinstance(topics, list):
         if not topics or len(topics) > MAX_TOPICS:
-            raise ApiError(400, "bad_topics", f"'topics' as a list holds 1 to {MAX_TOPICS} topic names")
+            raise ApiError(400, "bad_topics", "'topics' as a list holds 1 to %(max_topics)s topic names",
+                           max_topics=MAX_TOPICS)
         try:
             topics = list(dict.fromkeys(topic_name(t, "topics") for t in topics))
         except InvalidInput as exc:
-            raise ApiError(400, exc.code, str(exc)) from None
+            raise ApiError(400, exc.code, text_of(exc)) from None
     else:
         raise ApiError(400, "bad_topics", "'topics' is \"all\", \"preset:NAME\" or a list of topic names")
     camera = body.get("camera", False)
@@ -60,7 +62,8 @@ def parse_selection(body: dict) -> Selection:
         raise ApiError(400, "bad_type", "'camera' is true or false")
     name = body.get("name", "")
     if not isinstance(name, str) or len(name) > MAX_NAME or any(ord(c) < 32 for c in name):
-        raise ApiError(400, "bad_name", f"'name' is text of at most {MAX_NAME} characters, on one line")
+        raise ApiError(400, "bad_name", "'name' is text of at most %(max_name)s characters, on one line",
+                       max_name=MAX_NAME)
     return Selection(topics, camera, name.strip())
 
 

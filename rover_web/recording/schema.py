@@ -17,6 +17,8 @@ import sys
 from functools import lru_cache
 from pathlib import Path
 
+from rover_web.web.api_messages import explain
+
 SEPARATOR = "=" * 80
 PRIMITIVES = frozenset({"bool", "byte", "char", "float32", "float64", "int8", "uint8", "int16", "uint16",
                         "int32", "uint32", "int64", "uint64", "string", "wstring"})
@@ -40,8 +42,9 @@ def _msg_file(package: str, name: str) -> str:
         path = prefix / "share" / package / "msg" / f"{name}.msg"
         if path.is_file():
             return path.read_text(encoding="utf-8")
-    raise SchemaNotFound(f"{package}/msg/{name}.msg is not installed (looked under AMENT_PREFIX_PATH and "
-                         f"{sys.prefix})")
+    raise SchemaNotFound(explain("%(package)s/msg/%(name)s.msg is not installed (looked under AMENT_PREFIX_PATH "
+                                 "and %(prefix)s)",
+                                 package=package, name=name, prefix=sys.prefix))
 
 
 # rosbag2's own pattern for a field's type at the start of a line ("foo_msgs/Bar" in "foo_msgs/Bar[] bar"):
@@ -66,7 +69,8 @@ def schema_text(type_name: str) -> str:
     """The full ros2msg definition of "pkg/msg/Type" (or "pkg/Type"); SchemaNotFound if missing."""
     match = _TYPE_NAME.match(type_name)
     if match is None:
-        raise SchemaNotFound(f"{type_name!r} is not a message type name like std_msgs/msg/String")
+        raise SchemaNotFound(explain("%(type_name)s is not a message type name like std_msgs/msg/String",
+                                     type_name=repr(type_name)))
     package, name = match.groups()
     seen: set[str] = set()
 

@@ -21,6 +21,7 @@ from rover_web.core.state import Rover
 from rover_web.ros.graph import matching_qos, topic_types
 from rover_web.ros.raw import string_cdr
 from rover_web.ros.raw_taker import RawTaker
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import ApiError
 
 from . import file_index, upload
@@ -81,8 +82,9 @@ class RecordingService:
     def start(self, selection: Selection, by: str) -> dict:
         with self._lock:
             if self._active is not None:
-                raise ApiError(409, "recording_in_progress", f"recording {self._active.id} is running on "
-                               f"{self.rover.robot.name}: stop it first (one recording at a time per robot)")
+                raise ApiError(409, "recording_in_progress", "recording %(id)s is running on %(name)s: stop it first "
+                                                             "(one recording at a time per robot)",
+                               id=self._active.id, name=self.rover.robot.name)
             self.check_room()
             channels, skipped, left_out = self._choose(selection)
             recording_id = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime()) + "-" + secrets.token_hex(3)
@@ -96,7 +98,8 @@ class RecordingService:
                                     on_end=self._ended)
             except OSError as exc:
                 path.unlink(missing_ok=True)
-                raise ApiError(507, "cannot_write", f"cannot write {path}: {exc.strerror or exc}") from None
+                raise ApiError(507, "cannot_write", "cannot write %(path)s: %(value)s",
+                               path=path, value=exc.strerror or exc) from None
             active = _Active(recording_id, recorder)
             self.index.add({
                 "id": recording_id, "robot": self.rover.robot.name, "name": selection.name, "file": path.name,
@@ -112,7 +115,9 @@ class RecordingService:
             self._teardown(active)
             active.recorder.error = f"{type(exc).__name__}: {exc}"[:300]
             active.recorder.stop("subscribe_failed")
-            raise ApiError(503, "subscribe_failed", f"could not subscribe to the topics: {exc}") from None
+            raise ApiError(
+                503, "subscribe_failed", "could not subscribe to the topics: %(why)s", why=text_of(exc)
+            ) from None
         self.rover.audit.record("recording.start", by=by, detail=f"recording {recording_id} started",
                                 recording=recording_id, topics=len(channels))
         return self.status(recording_id)
@@ -121,7 +126,7 @@ class RecordingService:
         with self._lock:
             active = self._active
         if self.index.get(recording_id) is None or self.index.get(recording_id)["robot"] != self.rover.robot.name:
-            raise ApiError(404, "not_found", f"no recording {recording_id!r}")
+            raise ApiError(404, "not_found", "no recording %(recording_id)s", recording_id=repr(recording_id))
         if active is None or active.id != recording_id:
             return self.status(recording_id)  # already stopped: stopping again changes nothing
         self.rover.audit.record("recording.stop", by=by, detail=f"recording {recording_id} stopped",
@@ -143,7 +148,7 @@ class RecordingService:
     def status(self, recording_id: str) -> dict:
         row = self.index.get(recording_id)
         if row is None or row["robot"] != self.rover.robot.name:
-            raise ApiError(404, "not_found", f"no recording {recording_id!r}")
+            raise ApiError(404, "not_found", "no recording %(recording_id)s", recording_id=repr(recording_id))
         active = self._active
         return self._view(row, active.recorder if active is not None and active.id == recording_id else None)
 
@@ -155,7 +160,7 @@ class RecordingService:
     def path_of(self, recording_id: str) -> Path:
         row = self.index.get(recording_id)
         if row is None or row["robot"] != self.rover.robot.name:
-            raise ApiError(404, "not_found", f"no recording {recording_id!r}")
+            raise ApiError(404, "not_found", "no recording %(recording_id)s", recording_id=repr(recording_id))
         return self.folder / row["file"]
 
     def delete(self, recording_id: str, by: str) -> None:
@@ -182,8 +187,9 @@ class RecordingService:
         elif isinstance(selection.topics, str):
             preset = selection.topics.removeprefix("preset:")
             if preset not in self.presets:
-                raise ApiError(400, "unknown_preset", f"no preset {preset!r}; presets: "
-                               f"{', '.join(sorted(self.presets)) or 'none'} (ROVER_WEB_RECORDING_PRESETS)")
+                raise ApiError(400, "unknown_preset", "no preset %(preset)s; presets: %(value)s "
+                                                      "(ROVER_WEB_RECORDING_PRESETS)",
+                               preset=repr(preset), value=', '.join(sorted(self.presets)) or 'none')
             wanted = [self.rover.resolve(t) for t in self.presets[preset]]
             strict = False
         else:
@@ -207,8 +213,8 @@ class RecordingService:
             elif topic != AUDIT_TOPIC:
                 channels[topic] = type_name
         if strict and skipped:
-            raise ApiError(422, "unknown_topic", f"not recordable (no publisher seen, or its message definition "
-                           f"is not installed): {', '.join(skipped[:10])}")
+            raise ApiError(422, "unknown_topic", "not recordable (no publisher seen, or its message definition is "
+                                                 "not installed): %(skipped)s", skipped=', '.join(skipped[:10]))
         return channels, skipped, left_out
 
     def _subscribe(self, active: _Active, channels: dict[str, str]) -> None:
@@ -272,11 +278,17 @@ class RecordingService:
         """507 unless the folder and the disk have room for a recording (or an upload of `adding` bytes)."""
         self.folder.mkdir(mode=0o700, parents=True, exist_ok=True)
         if self._folder_bytes() + adding >= self.folder_max_bytes:
-            raise ApiError(507, "folder_full", "the recordings take ROVER_WEB_RECORDINGS_MAX_MB already"
-                           + (" with this file" if adding else "") + ": delete some first")
+            if adding:
+                raise ApiError(507, "folder_full", "the recordings take ROVER_WEB_RECORDINGS_MAX_MB already with this "
+                                                   "file: delete some first")
+            raise ApiError(
+                507, "folder_full", "the recordings take ROVER_WEB_RECORDINGS_MAX_MB already: delete some first"
+            )
         if shutil.disk_usage(self.folder).free - adding < self.min_free_bytes:
-            raise ApiError(507, "disk_low", "the disk has less free space than ROVER_WEB_RECORDINGS_MIN_FREE_MB"
-                           + (" once this file is stored" if adding else ""))
+            if adding:
+                raise ApiError(507, "disk_low", "the disk has less free space than ROVER_WEB_RECORDINGS_MIN_FREE_MB "
+                                                "once this file is stored")
+            raise ApiError(507, "disk_low", "the disk has less free space than ROVER_WEB_RECORDINGS_MIN_FREE_MB")
 
     def add_uploaded(self, row: dict) -> None:
         """An uploaded file's row (upload.py has checked and renamed the file)."""

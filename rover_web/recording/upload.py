@@ -22,6 +22,7 @@ from pathlib import Path
 
 from werkzeug.exceptions import ClientDisconnected, RequestEntityTooLarge
 
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import ApiError
 
 from .file_index import Refused, remember, walk
@@ -57,7 +58,7 @@ def receive(service, request, name: str, by: str) -> dict:
         try:
             index = walk(part, strict=True)
         except Refused as exc:
-            raise ApiError(422, exc.code, str(exc)) from None
+            raise ApiError(422, exc.code, text_of(exc)) from None
         decodable = [t for t, info in index.topics().items() if info["decodable"]]
         if not decodable:
             raise ApiError(422, "not_ros2", "this MCAP file holds no ROS 2 message (a cdr channel with a ros2msg "
@@ -100,10 +101,12 @@ def _copy(stream, part: Path, limit: int) -> int:
         raise ApiError(400, "upload_incomplete", "the upload stopped before the whole body arrived; "
                                                  "nothing was stored") from None
     except OSError as exc:
-        raise ApiError(507, "cannot_write", f"cannot write the upload: {exc.strerror or exc}") from None
+        raise ApiError(507, "cannot_write", "cannot write the upload: %(value)s",
+                       value=exc.strerror or exc) from None
     return size
 
 
 def _too_large(limit: int) -> ApiError:
-    return ApiError(413, "upload_too_large", f"the file is larger than ROVER_WEB_RECORDING_UPLOAD_MAX_MB "
-                                             f"({limit / (1024 * 1024):g} MB); nothing was stored")
+    return ApiError(413, "upload_too_large", "the file is larger than ROVER_WEB_RECORDING_UPLOAD_MAX_MB (%(value)s "
+                                             "MB); nothing was stored",
+                    value=format(limit / (1024 * 1024), "g"))

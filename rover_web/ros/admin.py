@@ -22,6 +22,8 @@ from rcl_interfaces.msg import Parameter as ParameterMsg
 from rcl_interfaces.msg import ParameterType, ParameterValue
 from rcl_interfaces.srv import DescribeParameters, GetParameters, ListParameters, SetParameters
 
+from rover_web.web.api_messages import explain
+
 from .actions import cancel_if_accepted
 from .convert import message_to_dict
 from .side_node import SideNode
@@ -179,14 +181,16 @@ class AdminNode:
         future.add_done_callback(lambda _f: done.set())
         self._side.wake()
         if not done.wait(timeout_s):
-            raise NoAnswer(f"{what} did not answer within {timeout_s:g} s")
+            raise NoAnswer(explain("%(what)s did not answer within %(timeout_s)s s",
+                                   what=what, timeout_s=format(timeout_s, "g")))
         return future.result()
 
     def call(self, srv_cls: type, service: str, request, timeout_s: float) -> Any:
         """Call a service; the response message, or NoAnswer."""
         client = self._client("srv", srv_cls, service)
         if not client.wait_for_service(timeout_sec=min(timeout_s, 2.0)):
-            raise NoAnswer(f"no server for {service} answered within {min(timeout_s, 2.0):g} s")
+            raise NoAnswer(explain("no server for %(service)s answered within %(timeout_s)s s",
+                                   service=service, timeout_s=format(min(timeout_s, 2.0), "g")))
         future = client.call_async(request)
         try:
             return self._wait(future, timeout_s, service)
@@ -239,7 +243,8 @@ class AdminNode:
         The callbacks run on the admin executor with plain values."""
         client = self._client("action", action_cls, action)
         if not client.wait_for_server(timeout_sec=timeout_s):
-            raise NoAnswer(f"no action server for {action} answered within {timeout_s:g} s")
+            raise NoAnswer(explain("no action server for %(action)s answered within %(timeout_s)s s",
+                                   action=action, timeout_s=format(timeout_s, "g")))
 
         def feedback(msg) -> None:
             on_feedback(message_to_dict(msg.feedback, 64))
@@ -273,5 +278,5 @@ class AdminNode:
         self._side.wake()
         if timeout_s is None:
             return None
-        response = self._wait(future, timeout_s, "the action server")
+        response = self._wait(future, timeout_s, explain("the action server"))
         return CANCEL_CODES.get(response.return_code, "error")

@@ -20,6 +20,8 @@ from rosidl_parser.definition import (
     NamespacedType,
 )
 
+from rover_web.web.api_messages import explain
+
 from .typesupport import message_class
 
 INT_RANGES = {
@@ -37,7 +39,8 @@ class FieldError(ValueError):
     """A value that does not fit its field; `path` names the field, `code` the short reason."""
 
     def __init__(self, path: str, message: str, code: str = "bad_field"):
-        super().__init__(f"{path or 'the value'}: {message}")
+        super().__init__(explain("%(path)s: %(why)s", path=path, why=message) if path
+                         else explain("the value: %(why)s", why=message))
         self.path, self.code = path, code
 
 
@@ -58,15 +61,22 @@ def build(cls: type, data: Any, path: str = "", depth: int = 0) -> Any:
     """A message of `cls` from a JSON object; FieldError if any field does not fit. Missing fields
     keep their defaults."""
     if depth > MAX_DEPTH:
-        raise FieldError(path, "nested too deeply", "too_deep")
+        raise FieldError(path, explain("nested too deeply"), "too_deep")
     if not isinstance(data, dict):
-        raise FieldError(path, f"must be an object, got {_type_word(data)}", "bad_type")
+        raise FieldError(path, explain("must be an object, got %(type_word)s", type_word=_type_word(data)), "bad_type")
     fields = cls.get_fields_and_field_types()
     unknown = [k for k in data if k not in fields]
     if unknown:
         name = str(unknown[0])[:60]
-        raise FieldError(_join(path, name), f"{cls.__name__} has no such field; its fields: "
-                         f"{', '.join(fields) or '(none)'}", "unknown_field")
+        raise FieldError(
+            _join(path, name),
+            explain(
+                "%(name)s has no such field; its fields: %(value)s",
+                name=cls.__name__,
+                value=", ".join(fields) or "(none)",
+            ),
+            "unknown_field",
+        )
     msg = cls()
     for (name, _), slot in zip(fields.items(), cls.SLOT_TYPES, strict=True):
         if name in data:
@@ -79,52 +89,67 @@ def _value(slot: Any, value: Any, path: str, depth: int) -> Any:
         return _basic(slot.typename, value, path)
     if isinstance(slot, AbstractGenericString):
         if not isinstance(value, str):
-            raise FieldError(path, f"must be a string, got {_type_word(value)}", "bad_type")
+            raise FieldError(
+                path, explain("must be a string, got %(type_word)s", type_word=_type_word(value)), "bad_type"
+            )
         limit = getattr(slot, "maximum_size", None)
         if limit is not None and len(value) > limit:
-            raise FieldError(path, f"is longer than its bound of {limit} characters", "too_long")
+            raise FieldError(path, explain("is longer than its bound of %(limit)s characters", limit=limit), "too_long")
         if "\x00" in value:
-            raise FieldError(path, "may not contain a NUL character", "bad_value")
+            raise FieldError(path, explain("may not contain a NUL character"), "bad_value")
         return value
     if isinstance(slot, NamespacedType):
         return build(_nested_class(slot), value, path, depth)
     if isinstance(slot, (Array, AbstractSequence)):
         if not isinstance(value, list):
-            raise FieldError(path, f"must be an array, got {_type_word(value)}", "bad_type")
+            raise FieldError(
+                path, explain("must be an array, got %(type_word)s", type_word=_type_word(value)), "bad_type"
+            )
         if isinstance(slot, Array) and len(value) != slot.size:
-            raise FieldError(path, f"must have exactly {slot.size} items, got {len(value)}", "bad_length")
+            raise FieldError(path, explain("must have exactly %(size)s items, got %(count)s",
+                                           size=slot.size, count=len(value)), "bad_length")
         if isinstance(slot, BoundedSequence) and len(value) > slot.maximum_size:
-            raise FieldError(path, f"may have at most {slot.maximum_size} items, got {len(value)}", "too_long")
+            raise FieldError(path, explain("may have at most %(maximum_size)s items, got %(count)s",
+                                           maximum_size=slot.maximum_size, count=len(value)), "too_long")
         items = [_value(slot.value_type, item, f"{path}[{i}]", depth) for i, item in enumerate(value)]
         return items
-    raise FieldError(path, f"has a type this browser cannot fill ({type(slot).__name__})", "unsupported")
+    raise FieldError(
+        path, explain("has a type this browser cannot fill (%(type)s)", type=type(slot).__name__), "unsupported"
+    )
 
 
 def _basic(typename: str, value: Any, path: str) -> Any:
     if typename == "boolean":
         if not isinstance(value, bool):
-            raise FieldError(path, f"must be true or false, got {_type_word(value)}", "bad_type")
+            raise FieldError(
+                path, explain("must be true or false, got %(type_word)s", type_word=_type_word(value)), "bad_type"
+            )
         return value
     if typename in FLOATS:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise FieldError(path, f"must be a number, got {_type_word(value)}", "bad_type")
+            raise FieldError(
+                path, explain("must be a number, got %(type_word)s", type_word=_type_word(value)), "bad_type"
+            )
         try:
             number = float(value)
         except OverflowError:
-            raise FieldError(path, "is too large for a number", "out_of_range") from None
+            raise FieldError(path, explain("is too large for a number"), "out_of_range") from None
         if not math.isfinite(number):
-            raise FieldError(path, "must be finite", "non_finite")
+            raise FieldError(path, explain("must be finite"), "non_finite")
         if typename == "float" and abs(number) > FLOAT32_MAX:
-            raise FieldError(path, "is out of range for a 32-bit float", "out_of_range")
+            raise FieldError(path, explain("is out of range for a 32-bit float"), "out_of_range")
         return number
     low, high = INT_RANGES[typename]
     if isinstance(value, bool) or not isinstance(value, int):
         if isinstance(value, float) and value.is_integer():
             value = int(value)  # JSON from a browser writes 3 as 3.0 sometimes
         else:
-            raise FieldError(path, f"must be an integer, got {_type_word(value)}", "bad_type")
+            raise FieldError(
+                path, explain("must be an integer, got %(type_word)s", type_word=_type_word(value)), "bad_type"
+            )
     if not low <= value <= high:
-        raise FieldError(path, f"must be between {low} and {high} ({typename})", "out_of_range")
+        raise FieldError(path, explain("must be between %(low)s and %(high)s (%(typename)s)",
+                                       low=low, high=high, typename=typename), "out_of_range")
     return bytes([value]) if typename == "octet" else value
 
 

@@ -19,6 +19,8 @@ import uuid
 from collections.abc import Callable
 from typing import Any
 
+from rover_web.web.api_messages import explain
+
 from .actions import cancel_if_accepted
 from .side_node import SideNode
 
@@ -61,7 +63,8 @@ class GoalClient:
         future.add_done_callback(lambda _f: done.set())
         self._side.wake()
         if not done.wait(timeout_s):
-            raise NoAnswer(f"{what} did not answer within {timeout_s:g} s")
+            raise NoAnswer(explain("%(what)s did not answer within %(timeout_s)s s",
+                                   what=what, timeout_s=format(timeout_s, "g")))
         return future.result()
 
     def send_goal(self, action_cls: type, name: str, goal, timeout_s: float,
@@ -72,7 +75,8 @@ class GoalClient:
         """
         client = self.action(action_cls, name)
         if not client.wait_for_server(timeout_sec=timeout_s):
-            raise NoAnswer(f"no action server for {name} answered within {timeout_s:g} s")
+            raise NoAnswer(explain("no action server for %(name)s answered within %(timeout_s)s s",
+                                   name=name, timeout_s=format(timeout_s, "g")))
         sending = client.send_goal_async(goal, feedback_callback=lambda msg: on_feedback(msg.feedback))
         try:
             handle = self._wait(sending, timeout_s, name)

@@ -8,6 +8,8 @@ import re
 from functools import lru_cache
 from pathlib import Path
 
+from rover_web.web.api_messages import explain
+
 # \Z, not $: "$" also matches before a trailing newline.
 _TYPE_RE = re.compile(r"([a-z][a-z0-9_]*)/(?:msg/)?([A-Z][A-Za-z0-9]*)\Z")
 
@@ -21,17 +23,23 @@ def message_class(type_name: str) -> type:
     """Import a message class by name; raise UnknownMessageType with the reason otherwise."""
     match = _TYPE_RE.match(type_name) if isinstance(type_name, str) else None
     if not match:
-        raise UnknownMessageType(f"{type_name!r} is not a message type name like std_msgs/msg/String")
+        raise UnknownMessageType(explain("%(type_name)s is not a message type name like std_msgs/msg/String",
+                                         type_name=repr(type_name)))
     package, name = match.groups()
     if not is_interface_package(package):
-        raise UnknownMessageType(f"{package!r} is not installed as a ROS interface package")
+        raise UnknownMessageType(explain("%(package)s is not installed as a ROS interface package",
+                                         package=repr(package)))
     try:
         module = importlib.import_module(f"{package}.msg")
     except ImportError:
-        raise UnknownMessageType(f"message package {package!r} is not installed") from None
+        raise UnknownMessageType(
+            explain("message package %(package)s is not installed", package=repr(package))
+        ) from None
     cls = getattr(module, name, None)
     if cls is None or not hasattr(cls, "get_fields_and_field_types"):
-        raise UnknownMessageType(f"{package} has no message {name!r}") from None
+        raise UnknownMessageType(
+            explain("%(package)s has no message %(name)s", package=package, name=repr(name))
+        ) from None
     return cls
 
 
@@ -63,19 +71,23 @@ def interface_class(type_name: str) -> type:
     only from a ROS interface package; UnknownMessageType with the reason otherwise."""
     match = _INTERFACE_RE.match(type_name) if isinstance(type_name, str) else None
     if not match:
-        raise UnknownMessageType(f"{str(type_name)[:80]!r} is not an interface type name like "
-                                 "std_srvs/srv/Trigger or test_msgs/action/Fibonacci")
+        raise UnknownMessageType(explain("%(type_name)s is not an interface type name like std_srvs/srv/Trigger or "
+                                         "test_msgs/action/Fibonacci",
+                                         type_name=repr(str(type_name)[:80])))
     package, kind, name = match.groups()
     if kind == "msg":
         return message_class(type_name)
     if not is_interface_package(package):
-        raise UnknownMessageType(f"{package!r} is not installed as a ROS interface package")
+        raise UnknownMessageType(explain("%(package)s is not installed as a ROS interface package",
+                                         package=repr(package)))
     try:
         module = importlib.import_module(f"{package}.{kind}")
     except ImportError:
-        raise UnknownMessageType(f"{package!r} has no {kind} types installed") from None
+        raise UnknownMessageType(explain("%(package)s has no %(kind)s types installed",
+                                         package=repr(package), kind=kind)) from None
     cls = getattr(module, name, None)
     marker = "Request" if kind == "srv" else "Goal"
     if cls is None or not hasattr(cls, marker):
-        raise UnknownMessageType(f"{package} has no {kind} {name!r}") from None
+        raise UnknownMessageType(explain("%(package)s has no %(kind)s %(name)s",
+                                         package=package, kind=kind, name=repr(name))) from None
     return cls

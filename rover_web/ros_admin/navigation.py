@@ -10,6 +10,8 @@ action's own name. Pure Python.
 
 from __future__ import annotations
 
+from rover_web.web.api_messages import explain
+
 # nav2_msgs actions that move the robot (ComputePathToPose, ComputePathThroughPoses and SmoothPath
 # only plan, and stay allowed).
 NAV2_MOTION = frozenset({"NavigateToPose", "NavigateThroughPoses", "FollowWaypoints", "FollowGPSWaypoints",
@@ -27,7 +29,8 @@ def navigation_refusal(action: str, type_name: object) -> str | None:
     """Why a goal to `action` of `type_name` is refused, or None."""
     package, _, name = type_name.partition("/action/") if isinstance(type_name, str) else ("", "", "")
     if package == "nav2_msgs" and name in NAV2_MOTION:
-        return f"{type_name} goals move the robot unchecked from here: {ROUTES}"
+        return explain("%(type)s goals move the robot unchecked from here: %(routes)s", type=type_name, routes=ROUTES)
     if action.rstrip("/").rpartition("/")[2] in MOTION_ACTION_NAMES:
-        return f"{action} is a navigation action; its goals move the robot unchecked from here: {ROUTES}"
+        return explain("%(action)s is a navigation action; its goals move the robot unchecked from here: %(routes)s",
+                       action=action, routes=ROUTES)
     return None

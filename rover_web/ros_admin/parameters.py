@@ -10,6 +10,8 @@ import math
 import re
 from typing import Any
 
+from rover_web.web.api_messages import Text, explain
+
 INT64 = (-2**63, 2**63 - 1)
 SCALARS = ("bool", "integer", "double", "string")
 ARRAYS = ("byte_array", "bool_array", "integer_array", "double_array", "string_array")
@@ -27,8 +29,8 @@ class ParameterRefused(Exception):
         self.status, self.code = status, code
 
 
-def _bad(message: str, code: str = "bad_type") -> ParameterRefused:
-    return ParameterRefused(400, code, message)
+def _bad(message_text: Text, code: str = "bad_type") -> ParameterRefused:
+    return ParameterRefused(400, code, message_text)
 
 
 def _is_int(v: Any) -> bool:
@@ -55,59 +57,62 @@ def infer_kind(value: Any) -> str:
             first = "double"
         if first in SCALARS:
             return f"{first}_array"
-    raise _bad("cannot tell the parameter type of this value; send a boolean, number, string or "
-               "non-empty array of one of those")
+    raise _bad(explain("cannot tell the parameter type of this value; send a boolean, number, string or non-empty "
+                       "array of one of those"))
 
 
 def _scalar(kind: str, value: Any, where: str) -> Any:
     if kind == "bool":
         if not isinstance(value, bool):
-            raise _bad(f"{where} must be true or false")
+            raise _bad(explain("%(where)s must be true or false", where=where))
         return value
     if kind == "integer":
         if isinstance(value, float) and value.is_integer() and abs(value) < 2**53:
             value = int(value)
         if not _is_int(value):
-            raise _bad(f"{where} must be an integer")
+            raise _bad(explain("%(where)s must be an integer", where=where))
         if not INT64[0] <= value <= INT64[1]:
-            raise _bad(f"{where} is out of the 64-bit integer range", "out_of_range")
+            raise _bad(explain("%(where)s is out of the 64-bit integer range", where=where), "out_of_range")
         return value
     if kind == "double":
         if not _is_number(value):
-            raise _bad(f"{where} must be a number")
+            raise _bad(explain("%(where)s must be a number", where=where))
         try:
             number = float(value)
         except OverflowError:
-            raise _bad(f"{where} is too large", "out_of_range") from None
+            raise _bad(explain("%(where)s is too large", where=where), "out_of_range") from None
         if not math.isfinite(number):
-            raise _bad(f"{where} must be finite", "non_finite")
+            raise _bad(explain("%(where)s must be finite", where=where), "non_finite")
         return number
     if kind == "string":
         if not isinstance(value, str):
-            raise _bad(f"{where} must be a string")
+            raise _bad(explain("%(where)s must be a string", where=where))
         if len(value) > MAX_STRING or "\x00" in value:
-            raise _bad(f"{where} is too long or holds a NUL character", "bad_value")
+            raise _bad(explain("%(where)s is too long or holds a NUL character", where=where), "bad_value")
         return value
     if kind == "byte":
         if not _is_int(value) or not 0 <= value <= 255:
-            raise _bad(f"{where} must be an integer from 0 to 255")
+            raise _bad(explain("%(where)s must be an integer from 0 to 255", where=where))
         return value
-    raise _bad(f"parameters of type {kind} cannot be set from here")
+    raise _bad(explain("parameters of type %(kind)s cannot be set from here", kind=kind))
 
 
 def check_value(param: dict, value: Any) -> tuple[str, Any]:
     """(type, value to send) for setting `param` (as AdminNode.parameters lists it) to `value`."""
     name = param["name"]
     if param.get("read_only"):
-        raise ParameterRefused(409, "read_only", f"{name} is read-only: it can only be set when the node starts")
+        raise ParameterRefused(409, "read_only", explain("%(name)s is read-only: it can only be set when the node "
+                                                         "starts",
+                                                         name=name))
     kind = param["type"]
     if param.get("dynamic_typing") or kind == "not_set":
         kind = infer_kind(value)
     if kind in ARRAYS:
         if not isinstance(value, list):
-            raise _bad(f"{name} is a {kind}: send an array")
+            raise _bad(explain("%(name)s is a %(kind)s: send an array", name=name, kind=kind))
         if len(value) > MAX_ARRAY_ITEMS:
-            raise _bad(f"{name}: at most {MAX_ARRAY_ITEMS} items", "too_long")
+            raise _bad(explain("%(name)s: at most %(max_array_items)s items",
+                               name=name, max_array_items=MAX_ARRAY_ITEMS), "too_long")
         item = kind[:-len("_array")]
         return kind, [_scalar(item, v, f"{name}[{i}]") for i, v in enumerate(value)]
     value = _scalar(kind, value, name)
@@ -130,6 +135,24 @@ def _check_range(name: str, bounds: dict | None, value: Any) -> None:
             steps = (value - low) / step
             on_step = abs(value - high) <= tolerance or abs(steps - round(steps)) * step <= tolerance
     if not inside:
-        raise _bad(f"{name} must be between {low:g} and {high:g}, got {value:g}", "out_of_range")
+        raise _bad(
+            explain(
+                "%(name)s must be between %(low)s and %(high)s, got %(value)s",
+                name=name,
+                low=format(low, "g"),
+                high=format(high, "g"),
+                value=format(value, "g"),
+            ),
+            "out_of_range",
+        )
     if not on_step:
-        raise _bad(f"{name} must be {low:g} plus a multiple of {step:g}, got {value:g}", "out_of_range")
+        raise _bad(
+            explain(
+                "%(name)s must be %(low)s plus a multiple of %(step)s, got %(value)s",
+                name=name,
+                low=format(low, "g"),
+                step=format(step, "g"),
+                value=format(value, "g"),
+            ),
+            "out_of_range",
+        )

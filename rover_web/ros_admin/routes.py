@@ -9,6 +9,7 @@ from flask import Blueprint, Response, jsonify, render_template, request
 
 from rover_web.auth import AuthService, may, signed_in_name
 from rover_web.core.state import current_feature, current_rover
+from rover_web.web.api_messages import text_of
 from rover_web.web.connection import peer_gone
 from rover_web.web.http import ApiError, error_response, json_body
 from rover_web.web.streams import once, opening
@@ -28,12 +29,12 @@ DEFAULT_SERVICE_TIMEOUT_S = 5.0
 
 @bp.errorhandler(AdminRefused)
 def refused(exc: AdminRefused):
-    return error_response(exc.status, exc.code, str(exc))
+    return error_response(exc.status, exc.code, text_of(exc))
 
 
 @bp.errorhandler(InvalidInput)
 def invalid(exc: InvalidInput):
-    return error_response(400, exc.code, str(exc))
+    return error_response(400, exc.code, text_of(exc))
 
 
 READ_METHODS = frozenset({"GET", "HEAD", "OPTIONS"})

@@ -22,6 +22,7 @@ from rover_web.panels.oplog import OperatorLog
 from rover_web.ros.admin import AdminNode, NoAnswer
 from rover_web.ros.fields import FieldError, build, describe
 from rover_web.ros.typesupport import UnknownMessageType, interface_class, is_interface_package
+from rover_web.web.api_messages import explain, text_of
 
 from .access import AccessRules, matches_any, parameter_subjects, parse_rules
 from .goals import Goal, GoalBook
@@ -51,12 +52,12 @@ class AdminRefused(Exception):
 
 def _type_class(type_name: str, kind: str) -> type:
     if not isinstance(type_name, str) or f"/{kind}/" not in type_name:
-        raise AdminRefused(400, "bad_type_name", f"'type' must name a {kind} type like "
-                           + ("std_srvs/srv/Trigger" if kind == "srv" else "test_msgs/action/Fibonacci"))
+        raise AdminRefused(400, "bad_type_name", explain("'type' must name a %(kind)s type like %(example)s", kind=kind,
+                           example="std_srvs/srv/Trigger" if kind == "srv" else "test_msgs/action/Fibonacci"))
     try:
         return interface_class(type_name)
     except UnknownMessageType as exc:
-        raise AdminRefused(422, "unknown_type", str(exc)) from None
+        raise AdminRefused(422, "unknown_type", text_of(exc)) from None
 
 
 def rules_from(config: dict) -> AccessRules:
@@ -85,7 +86,8 @@ class RosAdmin:
         with self._node_lock:
             if self._node is None:
                 if self.mode == "off" or not self.rover.runtime.running:
-                    raise AdminRefused(503, "ros_admin_unavailable", "ROS admin is off or the server is stopping")
+                    raise AdminRefused(503, "ros_admin_unavailable", explain("ROS admin is off or the server is "
+                                                                             "stopping"))
                 self._node = AdminNode(self.rover.runtime)
             return self._node
 
@@ -136,7 +138,7 @@ class RosAdmin:
 
     def _require_node(self, node: str) -> None:
         if not self.node.node_exists(node):
-            raise AdminRefused(404, "unknown_node", f"no node {node} in the ROS graph")
+            raise AdminRefused(404, "unknown_node", explain("no node %(node)s in the ROS graph", node=node))
 
     # --- parameters ---
 
@@ -145,7 +147,8 @@ class RosAdmin:
         try:
             return self.node.parameters(node, PARAMETER_TIMEOUT_S)
         except NoAnswer as exc:
-            raise AdminRefused(504, "no_answer", f"{node} did not list its parameters: {exc}") from None
+            raise AdminRefused(504, "no_answer", explain("%(node)s did not list its parameters: %(why)s",
+                                                         node=node, why=text_of(exc))) from None
 
     def set_parameter(self, node: str, name: str, value: Any, client: str) -> dict:
         label = f"{node} {name}"
@@ -154,26 +157,41 @@ class RosAdmin:
         try:
             self._check_rules(parameter_subjects(node, name))
             if self.is_safety_node(node) and self.estop.engaged:
-                raise AdminRefused(409, "estop_engaged", f"the e-stop is engaged and {node} is a safety node "
-                                   "(ROVER_WEB_ROS_ADMIN_SAFETY_NODES): its parameters stay as they are until "
-                                   "the e-stop is released")
+                raise AdminRefused(409, "estop_engaged", explain("the e-stop is engaged and %(node)s is a safety "
+                                                                 "node (ROVER_WEB_ROS_ADMIN_SAFETY_NODES): its "
+                                                                 "parameters stay as they are until the e-stop is "
+                                                                 "released",
+                                                                 node=node))
             params = {p["name"]: p for p in self.parameters(node)}
             if name not in params:
-                raise AdminRefused(404, "unknown_parameter", f"{node} has no parameter {name}")
+                raise AdminRefused(404, "unknown_parameter", explain("%(node)s has no parameter %(name)s",
+                                                                     node=node, name=name))
             try:
                 kind, checked = check_value(params[name], value)
             except ParameterRefused as exc:
-                raise AdminRefused(exc.status, exc.code, str(exc)) from None
+                raise AdminRefused(exc.status, exc.code, text_of(exc)) from None
             try:
                 ok, reason = self.node.set_parameter(node, name, kind, checked, PARAMETER_TIMEOUT_S)
             except NoAnswer as exc:
-                raise AdminRefused(504, "no_answer", str(exc)) from None
+                raise AdminRefused(504, "no_answer", text_of(exc)) from None
             if not ok:
-                raise AdminRefused(409, "refused_by_node", f"{node} refused {name}: {reason or 'no reason given'}")
+                raise AdminRefused(
+                    409,
+                    "refused_by_node",
+                    explain(
+                        "%(node)s refused %(name)s: %(value)s", node=node, name=name, value=reason or "no reason given"
+                    ),
+                )
         except AdminRefused as exc:
             # A refusal's message may quote the value ("got 0.3"): for a secret, only the code.
-            self.record("set_parameter", label, logged, "invalid" if exc.status == 400 else "refused",
-                        exc.code if secret else f"{exc.code}: {exc}", client)
+            self.record(
+                "set_parameter",
+                label,
+                logged,
+                "invalid" if exc.status == 400 else "refused",
+                exc.code if secret else f"{exc.code}: {exc}",
+                client,
+            )
             raise
         self.record("set_parameter", label, logged, "sent", "set", client)
         return {"node": node, "name": name, "type": kind, "value": checked}
@@ -190,7 +208,7 @@ class RosAdmin:
         except UnknownMessageType as exc:
             # An installed interface package without that type: 404; anything else: 422, as for calls.
             missing = is_interface_package(package) if package.isidentifier() else False
-            raise AdminRefused(404 if missing else 422, "unknown_type", str(exc)) from None
+            raise AdminRefused(404 if missing else 422, "unknown_type", text_of(exc)) from None
         if kind == "msg":
             return {"type": type_name, "fields": describe(cls)}
         if kind == "srv":
@@ -208,18 +226,28 @@ class RosAdmin:
             try:
                 message = build(cls.Request, request if request is not None else {}, "request")
             except FieldError as exc:
-                raise AdminRefused(400, exc.code, str(exc)) from None
+                raise AdminRefused(400, exc.code, text_of(exc)) from None
             self._check_estop("call_service", service, args, client)
             known = self.node.service_types(service)
             if known is None:
-                raise AdminRefused(404, "unknown_service", f"no service {service} in the ROS graph")
+                raise AdminRefused(404, "unknown_service", explain("no service %(service)s in the ROS graph",
+                                                                   service=service))
             if type_name not in known:
-                raise AdminRefused(400, "type_mismatch", f"{service} is a {', '.join(known)}, not {type_name}")
+                raise AdminRefused(
+                    400,
+                    "type_mismatch",
+                    explain(
+                        "%(service)s is a %(known)s, not %(type_name)s",
+                        service=service,
+                        known=", ".join(known),
+                        type_name=type_name,
+                    ),
+                )
             self._check_rules([("service", service)] + [("node", n) for n in self.node.serving_nodes(service)])
             try:
                 response = self.node.call(cls, service, message, timeout_s)
             except NoAnswer as exc:
-                raise AdminRefused(504, "no_answer", str(exc)) from None
+                raise AdminRefused(504, "no_answer", text_of(exc)) from None
         except AdminRefused as exc:
             self.record("call_service", service, args, "invalid" if exc.status in (400, 422) else "refused",
                         f"{exc.code}: {exc}", client)
@@ -235,14 +263,14 @@ class RosAdmin:
         args = {"type": type_name, "goal": scrub(goal)}
         try:
             self._check_rules([("action", action)])
-            refused = navigation_refusal(action, type_name)
-            if refused:
-                raise AdminRefused(403, "navigation_goal", refused)
+            refused_text = navigation_refusal(action, type_name)
+            if refused_text:
+                raise AdminRefused(403, "navigation_goal", refused_text)
             cls = _type_class(type_name, "action")
             try:
                 message = build(cls.Goal, goal if goal is not None else {}, "goal")
             except FieldError as exc:
-                raise AdminRefused(400, exc.code, str(exc)) from None
+                raise AdminRefused(400, exc.code, text_of(exc)) from None
             self._check_estop("send_goal", action, args, client)
             self._check_rules([("action", action)]
                               + [("node", n) for n in self.node.serving_nodes(action, action=True)])
@@ -251,9 +279,9 @@ class RosAdmin:
                 sent = self.node.send_goal(cls, action, message, GOAL_TIMEOUT_S, tracked.on_feedback,
                                            tracked.on_status, tracked.on_result)
             except NoAnswer as exc:
-                raise AdminRefused(504, "no_answer", str(exc)) from None
+                raise AdminRefused(504, "no_answer", text_of(exc)) from None
             if sent is None:
-                raise AdminRefused(409, "goal_rejected", f"{action} rejected the goal")
+                raise AdminRefused(409, "goal_rejected", explain("%(action)s rejected the goal", action=action))
         except AdminRefused as exc:
             self.record("send_goal", action, args, "invalid" if exc.status in (400, 422) else "refused",
                         f"{exc.code}: {exc}", client)
@@ -268,7 +296,9 @@ class RosAdmin:
     def goal(self, goal_id: str) -> Goal:
         tracked = self.goals.get(goal_id)
         if tracked is None:
-            raise AdminRefused(404, "unknown_goal", f"no goal {goal_id} was sent from here (or it is long finished)")
+            raise AdminRefused(404, "unknown_goal", explain("no goal %(goal_id)s was sent from here (or it is long "
+                                                            "finished)",
+                                                            goal_id=goal_id))
         return tracked
 
     def cancel_goal(self, goal_id: str, client: str) -> dict:
@@ -277,7 +307,7 @@ class RosAdmin:
             answer = self.node.cancel_goal(tracked.handle, CANCEL_TIMEOUT_S)
         except NoAnswer as exc:
             self.record("cancel_goal", tracked.action, {"goal_id": goal_id}, "refused", "no_answer", client)
-            raise AdminRefused(504, "no_answer", str(exc)) from None
+            raise AdminRefused(504, "no_answer", text_of(exc)) from None
         self.record("cancel_goal", tracked.action, {"goal_id": goal_id},
                     "sent" if answer in ("canceling", "terminated") else "refused", answer, client)
         return {"goal_id": goal_id, "cancel": answer, **{"status": tracked.snapshot()["status"]}}

@@ -6,6 +6,8 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from rover_web.web.api_messages import as_text
+
 if TYPE_CHECKING:
     from .sessions import Session
 
@@ -57,8 +59,11 @@ class Refused(Exception):
     """A request the controller will not carry out; `status` is the HTTP status it maps to."""
 
     def __init__(self, code: str, message: str, status: int = 409, **extra: Any):
-        super().__init__(message)
-        self.code, self.message, self.status, self.extra = code, message, status, extra
+        self.text = as_text(message, {})
+        super().__init__(self.text.english())
+        self.code, self.message, self.status, self.extra = code, self.text.english(), status, extra
 
-    def as_frame(self) -> dict:
-        return {"type": "error", "error": self.code, "message": self.message, "status": self.status, **self.extra}
+    def as_frame(self, catalogues: tuple | None = None) -> dict:
+        """The error frame, its message in the language of `catalogues` (the socket's)."""
+        return {"type": "error", "error": self.code, "message": self.text.translated(catalogues),
+                "status": self.status, **self.extra}

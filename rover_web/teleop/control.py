@@ -44,6 +44,8 @@ import time
 from collections import Counter
 from collections.abc import Callable
 
+from rover_web.web.api_messages import explain
+
 from .commands import REST_COMMANDS, Command, Limits, Refused, scale
 from .ramp import Ramp
 from .sessions import Session, Sessions
@@ -120,7 +122,8 @@ class TeleopController:
             if self._holder is session:
                 return
             if self._estop["engaged"]:
-                raise Refused("estop_engaged", "the e-stop is engaged: nobody takes control until it is released")
+                raise Refused("estop_engaged", explain("the e-stop is engaged: nobody takes control until it is "
+                                                       "released"))
             previous = self._holder
             self._holder = session
             self._audit("teleop.takeover", session, previous=previous.name if previous else None)
@@ -162,7 +165,9 @@ class TeleopController:
                 if late_s is None:
                     now = None  # dropped, and not measured either
                     self.stats["out_of_order_dropped"] += 1
-                    raise Refused("stale_seq", f"frame {seq} dropped: a newer frame from this socket came first")
+                    raise Refused("stale_seq", explain("frame %(seq)s dropped: a newer frame from this socket came "
+                                                       "first",
+                                                       seq=seq))
                 command = self._drive(session, linear, angular, epoch, late_s, now)
                 new_source = source != session.source  # logged once per change, not per frame
                 session.source = source
@@ -183,29 +188,46 @@ class TeleopController:
         """The rules for an admitted drive frame, with the lock held: the command it sets (published
         at once if it changed), or Refused."""
         if self._estop["engaged"]:
-            raise Refused("estop_engaged", "the e-stop is engaged: release it (POST /api/estop "
-                          '{"engaged": false}) before driving')
+            raise Refused("estop_engaged", explain("the e-stop is engaged: release it (POST /api/estop {\"engaged\": "
+                                                   "false}) before driving"))
         if not session.armed:
             if linear or angular:
-                raise Refused("rearm_required", f"the robot was stopped ({self._last_stop_reason()}) while "
-                              "this input was held: release the stick (or key) to re-arm, then drive")
+                raise Refused("rearm_required", explain("the robot was stopped (%(last_stop_reason)s) while this "
+                                                        "input was held: release the stick (or key) to re-arm, "
+                                                        "then drive",
+                                                        last_stop_reason=self._last_stop_reason()))
             session.armed = True
         if epoch != session.epoch:
             self.stats["stale_dropped"] += 1
-            raise Refused("stale_epoch", f"frame for epoch {epoch} dropped: the robot was stopped "
-                          f"({self._last_stop_reason()}); send epoch {session.epoch} to drive again",
-                          epoch=session.epoch)
+            raise Refused(
+                "stale_epoch",
+                explain(
+                    "frame for epoch %(epoch)s dropped: the robot was stopped "
+                    "(%(last_stop_reason)s); send epoch %(epoch2)s to drive again",
+                    epoch=epoch,
+                    last_stop_reason=self._last_stop_reason(),
+                    epoch2=session.epoch,
+                ),
+                epoch=session.epoch,
+            )
         if late_s >= self.deadman_max_s:  # its input is past the bound already (ramp.expired)
             self.stats["late_dropped"] += 1
-            raise Refused("late_frame", f"frame dropped: it arrived {1000 * late_s:.0f} ms late, past the "
-                          f"{1000 * self.deadman_max_s:.0f} ms any input may drive for")
+            raise Refused(
+                "late_frame",
+                explain(
+                    "frame dropped: it arrived %(value)s ms late, past the %(value2)s ms any input may drive for",
+                    value=format(1000 * late_s, ".0f"),
+                    value2=format(1000 * self.deadman_max_s, ".0f"),
+                ),
+            )
         if self._holder is None:
             self._holder = session
             self._audit("teleop.control_start", session)
             self._tell(session, "in_control")
         elif self._holder is not session:
-            raise Refused("not_in_control", f"{self._holder.name} holds control; you are view-only "
-                          'until they release it or you send {"takeover": true}',
+            raise Refused("not_in_control", explain("%(name)s holds control; you are view-only until they release "
+                                                    "it or you send {\"takeover\": true}",
+                                                    name=self._holder.name),
                           holder=self._holder.public())
         linear_mps, angular_rps = scale(linear, angular, self.limits)
         previous = self._command
@@ -246,13 +268,14 @@ class TeleopController:
             now = self._clock()
             self._expire(now)
             if self._closed:
-                raise Refused("shutting_down", "the server is shutting down", status=503)
+                raise Refused("shutting_down", explain("the server is shutting down"), status=503)
             if self._estop["engaged"]:
-                raise Refused("estop_engaged", "the e-stop is engaged: release it (POST /api/estop "
-                              '{"engaged": false}) before driving')
+                raise Refused("estop_engaged", explain("the e-stop is engaged: release it (POST /api/estop "
+                                                       "{\"engaged\": false}) before driving"))
             if self._holder is not None:
-                raise Refused("not_in_control", f"{self._holder.name} holds control with the joystick; "
-                              "REST commands run only while nobody holds it (stop always works)",
+                raise Refused("not_in_control", explain("%(name)s holds control with the joystick; REST commands "
+                                                        "run only while nobody holds it (stop always works)",
+                                                        name=self._holder.name),
                               holder=self._holder.public())
             direction = REST_COMMANDS[command]
             linear_mps, angular_rps = scale(direction[0] * speed, direction[1] * speed, self.limits)
@@ -372,9 +395,9 @@ class TeleopController:
 
     def _require_open(self, session: Session) -> None:
         if self._closed:
-            raise Refused("shutting_down", "the server is shutting down", status=503)
+            raise Refused("shutting_down", explain("the server is shutting down"), status=503)
         if not self._sessions.is_open(session):
-            raise Refused("disconnected", "this session is closed; reconnect", status=410)
+            raise Refused("disconnected", explain("this session is closed; reconnect"), status=410)
 
     def _expire(self, now: float) -> None:
         command = self._command

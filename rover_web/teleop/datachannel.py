@@ -119,7 +119,7 @@ class TeleopChannel:
             reply = handle_frame(self.controller, self.session, data, self.max_frame_bytes)
         except FrameError as exc:  # a frame a socket would be closed for: stop, say why, close the channel
             self.controller.disconnect(self.session)
-            self._call_soon(self._end, exc.as_frame())
+            self._call_soon(self._end, exc.as_frame(self.session.catalogues))
             return
         except Exception:
             log.exception("teleop frame from a data channel failed; closing the channel")

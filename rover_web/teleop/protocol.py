@@ -30,6 +30,7 @@ from typing import NamedTuple
 
 import orjson
 
+from rover_web.web.api_messages import as_text, explain, text_of
 from rover_web.web.validate import InvalidInput, json_type, loads_strict, number, only_keys, text
 
 from .commands import SOURCES
@@ -43,11 +44,13 @@ class FrameError(Exception):
     """`close_code` None means: answer with an error frame and keep the socket."""
 
     def __init__(self, code: str, message: str, close_code: int | None = None):
-        super().__init__(message)
-        self.code, self.message, self.close_code = code, message, close_code
+        self.text = as_text(message, {})
+        super().__init__(self.text.english())
+        # `message` stays English: it is also a close frame's reason (at most 123 bytes, for logs).
+        self.code, self.message, self.close_code = code, self.text.english(), close_code
 
-    def as_frame(self) -> dict:
-        return {"type": "error", "error": self.code, "message": self.message, "status": 400}
+    def as_frame(self, catalogues: tuple | None = None) -> dict:
+        return {"type": "error", "error": self.code, "message": self.text.translated(catalogues), "status": 400}
 
 
 class Drive(NamedTuple):  # a tuple: built 40 times a second, and cheaper than a frozen dataclass
@@ -90,32 +93,38 @@ def _loads(data: str):
 def parse_frame(data: str | bytes, max_bytes: int) -> Drive | Control | Pong:
     if isinstance(data, (bytes, bytearray)):
         if len(data) > max_bytes:
-            raise FrameError("frame_too_large", f"frames are limited to {max_bytes} bytes", CLOSE_MESSAGE_TOO_BIG)
-        raise FrameError("binary_frame", "send JSON text frames, not binary", CLOSE_UNSUPPORTED_DATA)
+            raise FrameError("frame_too_large", explain("frames are limited to %(max_bytes)s bytes",
+                                                        max_bytes=max_bytes), CLOSE_MESSAGE_TOO_BIG)
+        raise FrameError("binary_frame", explain("send JSON text frames, not binary"), CLOSE_UNSUPPORTED_DATA)
     # A character is at most 4 bytes in UTF-8: most frames need no encoding to be measured.
     if len(data) > max_bytes or (4 * len(data) > max_bytes
                                  and len(data.encode("utf-8", "surrogatepass")) > max_bytes):
-        raise FrameError("frame_too_large", f"frames are limited to {max_bytes} bytes", CLOSE_MESSAGE_TOO_BIG)
+        raise FrameError("frame_too_large", explain("frames are limited to %(max_bytes)s bytes",
+                                                    max_bytes=max_bytes), CLOSE_MESSAGE_TOO_BIG)
     try:
         obj = _loads(data)
     except InvalidInput as exc:
         if exc.code == "non_finite":
-            raise FrameError("non_finite", str(exc)) from None
-        raise FrameError("bad_json", f"frame is not JSON: {str(exc)[:120]}", CLOSE_INVALID_PAYLOAD) from None
+            raise FrameError("non_finite", text_of(exc)) from None
+        raise FrameError(
+            "bad_json", explain("frame is not JSON: %(why)s", why=str(exc)[:120]), CLOSE_INVALID_PAYLOAD
+        ) from None
     if not isinstance(obj, dict):
-        raise FrameError("bad_frame", f"a frame must be a JSON object, got {json_type(obj)}")
+        raise FrameError("bad_frame", explain("a frame must be a JSON object, got %(json_type)s",
+                                              json_type=json_type(obj)))
     try:
         for action in CONTROL_ACTIONS:
             if action in obj:
                 only_keys(obj, {action, "seq"} if action == "stop" else {action})
                 if obj[action] is not True:
-                    raise InvalidInput(f"'{action}' must be true", "bad_value")
+                    raise InvalidInput("'%(action)s' must be true", "bad_value", action=action)
                 return Control(action, _seq(obj) if "seq" in obj else None)
         if "pong" in obj:
             only_keys(obj, {"pong"})
             number_ = obj["pong"]
             if isinstance(number_, bool) or not isinstance(number_, int) or not 0 <= number_ < PING_ID_MAX:
-                raise InvalidInput(f"'pong' must be the id of a ping, a whole number below {PING_ID_MAX}", "bad_type")
+                raise InvalidInput("'pong' must be the id of a ping, a whole number below %(ping_id_max)s", "bad_type",
+                                   ping_id_max=PING_ID_MAX)
             return Pong(number_)
         only_keys(obj, DRIVE_KEYS)
         linear = number(obj, "linear", low=-1.0, high=1.0)
@@ -129,12 +138,12 @@ def parse_frame(data: str | bytes, max_bytes: int) -> Drive | Control | Pong:
         if "t" in obj:
             t = number(obj, "t", low=0.0, high=float(WHOLE_MAX))
     except InvalidInput as exc:
-        raise FrameError(exc.code, str(exc)) from None
+        raise FrameError(exc.code, text_of(exc)) from None
     return Drive(linear, angular, epoch, source, seq, t)
 
 
 def _seq(obj: dict) -> int:
     seq = obj["seq"]
     if isinstance(seq, bool) or not isinstance(seq, int) or not 0 <= seq < WHOLE_MAX:
-        raise InvalidInput(f"'seq' must be a whole number from 0 to {WHOLE_MAX - 1}", "bad_type")
+        raise InvalidInput("'seq' must be a whole number from 0 to %(value)s", "bad_type", value=WHOLE_MAX - 1)
     return seq

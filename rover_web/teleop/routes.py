@@ -10,6 +10,7 @@ from flask import Blueprint, jsonify, request
 
 from rover_web.auth import on_revoke, signed_in_name
 from rover_web.core.state import current_feature, current_rover
+from rover_web.web.api_messages import request_catalogues, text_of
 from rover_web.web.http import ApiError, json_body
 from rover_web.web.streams import stream_slot
 from rover_web.web.validate import InvalidInput, number, only_keys, text
@@ -44,6 +45,7 @@ def teleop_socket(ws) -> None:
     try:
         # Signed in, the session is the user's, whatever name the page asks for.
         session = controller.connect(signed_in_name() or operator_name(request.args.get("name")))
+        session.catalogues = request_catalogues()
         hello = {**controller.session_state(session, "connected"), "type": "hello", "session": session.id,
                  "name": session.name, **teleop.hello()}
         teleop_ws = TeleopSocket(ws, controller, session, teleop.max_frame_bytes)
@@ -88,24 +90,25 @@ def teleop_command():
         only_keys(body, {"command", "speed", "duration_s"})
         for key in ("speed", "duration_s"):
             if key in body and body[key] is None:
-                raise InvalidInput(f"'{key}' must be a number, got null", "bad_type")
+                raise InvalidInput("'%(key)s' must be a number, got null", "bad_type", key=key)
         command = text(body, "command", max_len=20)
         if command not in REST_COMMANDS:
-            raise InvalidInput(f"unknown command {command!r}; use one of {', '.join(REST_COMMANDS)}, stop",
-                               "unknown_command")
+            raise InvalidInput("unknown command %(command)s; use one of %(rest_commands)s, stop",
+                               "unknown_command", command=repr(command), rest_commands=', '.join(REST_COMMANDS))
         speed = number(body, "speed", low=0.0, high=1.0, default=config["ROVER_WEB_TELEOP_REST_DEFAULT_SPEED"])
         max_s = config["ROVER_WEB_TELEOP_REST_MAX_DURATION_S"]
         duration_s = number(body, "duration_s", low=0.0, high=max_s,
                             default=config["ROVER_WEB_TELEOP_REST_DEFAULT_DURATION_S"])
         if duration_s <= 0:
-            raise InvalidInput(f"'duration_s' must be greater than 0 and at most {max_s:g}", "out_of_range")
+            raise InvalidInput("'duration_s' must be greater than 0 and at most %(max_s)s", "out_of_range",
+                               max_s=format(max_s, "g"))
     except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, text_of(exc)) from None
     try:
         # The drive outlives this request: its credential is watched until the next one replaces
         # it, and a revocation stops it at once (rest_drive.py).
         linear_mps, angular_rps = teleop.rest.start(command, speed, duration_s, on_revoke)
     except Refused as exc:
-        raise ApiError(exc.status, exc.code, exc.message) from None
+        raise ApiError(exc.status, exc.code, exc.text) from None
     return jsonify(command=command, speed=speed, duration_s=duration_s, linear_mps=linear_mps,
                    angular_rps=angular_rps)

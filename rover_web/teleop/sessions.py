@@ -32,6 +32,9 @@ class Session:
     outbox: deque = field(default_factory=lambda: deque(maxlen=64))
     wake: Callable[[], None] | None = None
     link: LinkMeter = field(default_factory=LinkMeter)
+    # The language of the request that opened it (api_messages.request_catalogues): its error frames
+    # are made on the reader's thread, outside any request. None: English.
+    catalogues: tuple | None = None
 
     def public(self) -> dict:
         return {"id": self.id, "name": self.name}

@@ -29,6 +29,8 @@ import struct
 import threading
 import time
 
+from rover_web.web.api_messages import explain
+
 from .control import Refused, Session, TeleopController
 from .protocol import Control, Drive, FrameError, Pong, parse_frame
 from .ws_frames import (
@@ -91,7 +93,7 @@ def handle_frame(controller: TeleopController, session: Session, data, max_bytes
         controller.stop(session, "bad_input")  # zero if this socket was driving; ignored for viewers
         if exc.close_code is not None:
             raise
-        return exc.as_frame()
+        return exc.as_frame(session.catalogues)
     try:
         if isinstance(frame_, Drive):
             controller.drive(session, frame_.linear, frame_.angular, epoch=frame_.epoch, source=frame_.source,
@@ -106,10 +108,10 @@ def handle_frame(controller: TeleopController, session: Session, data, max_bytes
             controller.release(session)
         elif frame_.action == "estop":
             if controller.request_estop is None:
-                raise Refused("no_estop", "this server has no e-stop to engage", status=501)
+                raise Refused("no_estop", explain("this server has no e-stop to engage"), status=501)
             controller.request_estop(session.name)  # the engage hook tells every socket, this one too
     except Refused as exc:
-        return exc.as_frame()
+        return exc.as_frame(session.catalogues)
     return None
 
 

@@ -37,7 +37,7 @@ def add_nav(fleet: Fleet) -> None:
         rover.add_nav(N_("TF"), "/tf")
 
 
-def _init_robot(rover: Rover, msgs, missing: str | None) -> None:
+def _init_robot(rover: Rover, msgs, missing) -> None:
     service = TfService(rover, missing=missing, clock_ns=msgs.clock_ns(rover.runtime),
                          publishers=msgs.publishers(rover.runtime))
     rover.add_feature(service)

@@ -32,6 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rover_web.web.api_messages import as_text, explain
+
 # tf2's limits: a quaternion whose squared norm is off 1 by more than this is refused
 # (TF_DENORMALIZED_QUATERNION); a walk longer than this means a loop.
 QUATERNION_TOLERANCE = 1e-5
@@ -51,9 +53,10 @@ class TfError(Exception):
     """A refused lookup: ``kind`` is one of KINDS, ``message`` a tf2-like sentence, ``detail`` the figures."""
 
     def __init__(self, kind: str, message: str, **detail) -> None:
-        super().__init__(message)
+        self.text = as_text(message, {})
+        super().__init__(self.text.english())
         self.kind = kind
-        self.message = message
+        self.message = self.text.english()
         self.detail = detail
 
 
@@ -362,8 +365,9 @@ class TfBuffer:
         while f is not None and f.values:  # a frame whose every transform was refused has no link
             chain.append(f)
             if len(chain) > MAX_GRAPH_DEPTH:
-                raise TfError("invalid", f"The tf tree is invalid because it contains a loop (walking up from "
-                                         f"[{frame}]).", frame=frame)
+                raise TfError("invalid", explain("The tf tree is invalid because it contains a loop (walking up "
+                                                 "from [%(frame)s]).",
+                                                 frame=frame), frame=frame)
             f = self._frames.get(f.parent)
         return chain
 
@@ -377,15 +381,18 @@ class TfBuffer:
         source = clean_frame_id(source)
         stamp = int(stamp_ns or 0)
         if stamp < 0:
-            raise TfError("invalid", f"Requested time {stamp / 1e9:.6f} is negative", stamp_ns=stamp)
+            raise TfError("invalid", explain("Requested time %(value)s is negative",
+                                             value=format(stamp / 1e9, ".6f")), stamp_ns=stamp)
         with self._lock:
             for arg, name in (("target_frame", target), ("source_frame", source)):
                 if not name:
-                    raise TfError("invalid", f"Invalid argument passed to lookupTransform argument {arg} - "
-                                             "frame id is empty", argument=arg)
+                    raise TfError("invalid", explain("Invalid argument passed to lookupTransform argument %(arg)s "
+                                                     "- frame id is empty",
+                                                     arg=arg), argument=arg)
                 if not self._known(name):
-                    raise TfError("unknown_frame", f'"{name}" passed to lookupTransform argument {arg} does not '
-                                                   "exist.", frame=name, argument=arg)
+                    raise TfError("unknown_frame", explain("\"%(name)s\" passed to lookupTransform argument %(arg)s "
+                                                           "does not exist.",
+                                                           name=name, arg=arg), frame=name, argument=arg)
             if target == source:
                 return Transform.identity(stamp)
             path = self._paths.get((target, source))
@@ -426,8 +433,10 @@ class TfBuffer:
         for i, f in enumerate(up_s):
             if f.parent in t_names:
                 return up_s[:i + 1] + up_t[:t_names[f.parent] + 1], i + 1
-        raise TfError("not_connected", f"Could not find a connection between '{target}' and '{source}' because "
-                                       "they are not part of the same tree. Tf has two or more unconnected trees.",
+        raise TfError("not_connected", explain("Could not find a connection between '%(target)s' and '%(source)s' "
+                                               "because they are not part of the same tree. Tf has two or more "
+                                               "unconnected trees.",
+                                               target=target, source=source),
                       target=target, source=source)
 
     @staticmethod
@@ -444,13 +453,24 @@ class TfBuffer:
     @staticmethod
     def _extrapolation(direction: str, stamp: int, nearest: int, frame: _Frame, target: str, source: str) -> TfError:
         by = abs(stamp - nearest) / 1e9
-        edge = "earliest" if direction == "past" else "latest"
+        values = {"by": format(by, ".3f"), "value": format(stamp / 1e9, ".6f"),
+                  "value2": format(nearest / 1e9, ".6f"), "source": source, "target": target}
+        if direction == "past":
+            why_text = explain("Lookup would require extrapolation %(by)s s into the past. Requested time %(value)s "
+                               "but the earliest data is at time %(value2)s, when looking up transform from frame "
+                               "[%(source)s] to frame [%(target)s]", **values)
+        else:
+            why_text = explain("Lookup would require extrapolation %(by)s s into the future. Requested time "
+                               "%(value)s but the latest data is at time %(value2)s, when looking up transform from "
+                               "frame [%(source)s] to frame [%(target)s]", **values)
         return TfError(
             f"extrapolation_{direction}",
-            f"Lookup would require extrapolation {by:.3f} s into the {direction}. Requested time {stamp / 1e9:.6f} "
-            f"but the {edge} data is at time {nearest / 1e9:.6f}, when looking up transform from frame "
-            f"[{source}] to frame [{target}]",
-            by_s=by, frame=frame.name, requested_ns=stamp, nearest_ns=nearest)
+            why_text,
+            by_s=by,
+            frame=frame.name,
+            requested_ns=stamp,
+            nearest_ns=nearest,
+        )
 
     def can_transform(self, target: str, source: str, stamp_ns: int | None = None) -> bool:
         try:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from rover_web.ros import qos
 from rover_web.ros.typesupport import UnknownMessageType, message_class
+from rover_web.web.api_messages import Text, explain, text_of
 
 TF_MESSAGE = "tf2_msgs/msg/TFMessage"
 HOW_TO_GET = ("source /opt/ros/jazzy/setup.bash before starting rover_web (a ROS install has tf2_msgs), or "
@@ -17,12 +18,14 @@ DYNAMIC_QOS = qos.profile("default", depth=100)
 STATIC_QOS = qos.profile("latched", depth=100)
 
 
-def missing() -> str | None:
+def missing() -> Text | None:
     """None when tf2_msgs/msg/TFMessage can be subscribed; otherwise what is missing and how to get it."""
     try:
         message_class(TF_MESSAGE)
     except (UnknownMessageType, ImportError) as exc:
-        return f"{TF_MESSAGE} is not available ({exc}): {HOW_TO_GET}"
+        return explain(
+            "%(type)s is not available (%(why)s): %(how)s", type=TF_MESSAGE, why=text_of(exc), how=HOW_TO_GET
+        )
     return None
 
 

@@ -27,7 +27,7 @@ TICK_S = 1.0  # the page's refresh: ages move on even when nothing arrives
 
 
 class TfService:
-    def __init__(self, rover: Rover, *, missing: str | None = None, clock_ns=None, publishers=None):
+    def __init__(self, rover: Rover, *, missing=None, clock_ns=None, publishers=None):
         config = rover.config
         self.rover = rover
         self.buffer = TfBuffer(config["ROVER_WEB_TF_CACHE_S"])
@@ -78,9 +78,16 @@ class TfService:
         with self._lock:
             counts = dict(self.counts)
         publishers = {kind: self._publishers(topic) for kind, topic in self.topics.items()} if self.available else {}
-        return {"available": self.available, "missing": self.missing, "topics": self.topics, "publishers": publishers,
-                "settings_frames": self.frames, "counts": counts, "last_undecodable": self.last_undecodable,
-                **tree}
+        return {
+            "available": self.available,
+            "missing": None if self.missing is None else str(self.missing),
+            "topics": self.topics,
+            "publishers": publishers,
+            "settings_frames": self.frames,
+            "counts": counts,
+            "last_undecodable": self.last_undecodable,
+            **tree,
+        }
 
     def publish(self) -> None:
         if self.available:

@@ -8,6 +8,7 @@ from flask import Blueprint, Response, jsonify, render_template, request
 
 from rover_web.camera.msgs import IMAGE_TYPES
 from rover_web.core.state import current_feature
+from rover_web.web.api_messages import text_of
 from rover_web.web.connection import peer_gone
 from rover_web.web.http import error_response
 from rover_web.web.streams import once, opening
@@ -25,12 +26,12 @@ STATUS = {UnknownTopic: 404, AmbiguousType: 409, UnknownType: 422, Unavailable: 
 
 @bp.errorhandler(InvalidInput)
 def invalid_input(exc: InvalidInput):
-    return error_response(400, exc.code, str(exc))
+    return error_response(400, exc.code, text_of(exc))
 
 
 @bp.errorhandler(EchoRefused)
 def echo_refused(exc: EchoRefused):
-    return error_response(STATUS[type(exc)], exc.code, str(exc))
+    return error_response(STATUS[type(exc)], exc.code, text_of(exc))
 
 
 @bp.get("/topics")

@@ -11,6 +11,7 @@ from rover_web.core.state import Rover
 from rover_web.ros import graph
 from rover_web.ros.typesupport import UnknownMessageType, message_class
 from rover_web.ros.typesupport import type_name as canonical_type
+from rover_web.web.api_messages import explain, text_of
 from rover_web.web.validate import InvalidInput, topic_name
 
 from .echo import TopicEcho
@@ -98,44 +99,64 @@ class TopicBrowser:
         type_name = args.get("type") or None
         if type_name is None:
             if not known:
-                raise UnknownTopic(f"no topic {topic} in the ROS graph; give type=pkg/msg/Name to wait for it",
+                raise UnknownTopic(explain("no topic %(topic)s in the ROS graph; give type=pkg/msg/Name to wait "
+                                           "for it",
+                                           topic=topic),
                                    "unknown_topic")
             if len(known) > 1:
-                raise AmbiguousType(f"{topic} carries several types ({', '.join(known)}); choose one with type=",
+                raise AmbiguousType(explain("%(topic)s carries several types (%(known)s); choose one with type=",
+                                            topic=topic, known=', '.join(known)),
                                     "ambiguous_type")
             type_name = known[0]
         try:
             cls = message_class(type_name)
         except UnknownMessageType as exc:
-            raise UnknownType(f"cannot show {topic}: {exc}", "unknown_type") from None
+            raise UnknownType(
+                explain("cannot show %(topic)s: %(why)s", topic=topic, why=text_of(exc)), "unknown_type"
+            ) from None
         type_name = canonical_type(cls)
         if known and type_name not in known:
-            raise InvalidInput(f"{topic} carries {', '.join(known)}, not {type_name}", "type_mismatch")
+            raise InvalidInput("%(topic)s carries %(known)s, not %(type_name)s", "type_mismatch",
+                               topic=topic, known=', '.join(known), type_name=type_name)
         return topic, type_name
 
     def acquire(self, key: tuple[str, str], client: str | None = None) -> TopicEcho:
         with self._lock:
             if self._viewers >= self.max_viewers:
-                raise Unavailable(f"{self._viewers} topic echoes are open already", "too_many_streams")
+                raise Unavailable(
+                    explain("%(viewers)s topic echoes are open already", viewers=self._viewers), "too_many_streams"
+                )
             self._viewers += 1
         try:
             return self.echoes.acquire(key, client, self._share(client))
         except Closed:
             self._viewer_left()
-            raise Unavailable("the server is shutting down", "shutting_down") from None
+            raise Unavailable(explain("the server is shutting down"), "shutting_down") from None
         except ShareUsed as exc:
             self._viewer_left()
-            raise Unavailable(f"{exc} different topic echoes (ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT); close one first",
-                              "too_many_subscriptions") from None
+            raise Unavailable(
+                explain(
+                    "%(why)s different topic echoes (ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT); close one first",
+                    why=text_of(exc),
+                ),
+                "too_many_subscriptions",
+            ) from None
         except Full:
             self._viewer_left()
-            raise Unavailable(f"{len(self.echoes)} different topics are being echoed already "
-                              f"(ROVER_WEB_TOPICS_ECHO_MAX_SUBSCRIPTIONS); try again when one closes",
-                              "too_many_subscriptions") from None
+            raise Unavailable(
+                explain(
+                    "%(count)s different topics are being echoed already "
+                    "(ROVER_WEB_TOPICS_ECHO_MAX_SUBSCRIPTIONS); try again when one closes",
+                    count=len(self.echoes),
+                ),
+                "too_many_subscriptions",
+            ) from None
         except Exception as exc:
             self._viewer_left()
             log.exception("cannot subscribe to %s", key[0])
-            raise CannotSubscribe(f"cannot subscribe to {key[0]}: {exc}", "cannot_subscribe") from None
+            raise CannotSubscribe(
+                explain("cannot subscribe to %(key)s: %(why)s", key=key[0], why=text_of(exc)), "cannot_subscribe"
+            ) from None
 
     def release(self, key: tuple[str, str], client: str | None = None) -> None:
         self.echoes.release(key, client)

@@ -12,6 +12,8 @@ import os
 import re
 from dataclasses import dataclass
 
+from rover_web.web.api_messages import as_text, explain
+
 MESH_TYPES = {".stl": "model/stl", ".dae": "model/vnd.collada+xml", ".obj": "model/obj", ".mtl": "text/plain",
               ".png": "image/png", ".jpg": "image/jpeg", ".jpeg": "image/jpeg", ".tga": "image/x-tga"}
 _PACKAGE = re.compile(r"\A[A-Za-z][A-Za-z0-9_]{0,99}\Z")  # REP 144's package names
@@ -20,8 +22,9 @@ MAX_PATH = 1024
 
 class MeshRefused(Exception):
     def __init__(self, status: int, code: str, message: str):
-        super().__init__(message)
-        self.status, self.code, self.message = status, code, message
+        self.text = as_text(message, {})
+        super().__init__(self.text.english())
+        self.status, self.code, self.message = status, code, self.text.english()
 
 
 @dataclass(frozen=True)
@@ -44,38 +47,47 @@ def share_folder(package: str) -> str:
         return get_package_share_directory(package)
     except (PackageNotFoundError, ValueError, LookupError):
         raise MeshRefused(404, "unknown_package",
-                          f"package {package!r} is not in the ament index (AMENT_PREFIX_PATH)") from None
+                          explain("package %(package)s is not in the ament index (AMENT_PREFIX_PATH)",
+                                  package=repr(package))) from None
 
 
 def check_relative(path: str) -> list[str]:
     """The parts of a relative path inside a package, or MeshRefused 400."""
     if not path or len(path) > MAX_PATH:
-        raise MeshRefused(400, "bad_mesh_path", "a mesh path inside the package is 1 to 1024 characters")
+        raise MeshRefused(400, "bad_mesh_path", explain("a mesh path inside the package is 1 to 1024 characters"))
     if "\\" in path or "\x00" in path or path.startswith("/"):
-        raise MeshRefused(400, "bad_mesh_path", "a mesh path is relative to its package, with '/' between parts")
+        raise MeshRefused(400, "bad_mesh_path", explain("a mesh path is relative to its package, with '/' between "
+                                                        "parts"))
     parts = path.split("/")
     if any(part in ("", ".", "..") for part in parts):
-        raise MeshRefused(403, "outside_package", "a mesh path may not leave its package ('..', '.' or an empty part)")
+        raise MeshRefused(403, "outside_package", explain("a mesh path may not leave its package ('..', '.' or an "
+                                                          "empty part)"))
     return parts
 
 
 def resolve(package: str, path: str) -> MeshFile:
     if not _PACKAGE.match(package):
-        raise MeshRefused(400, "bad_package", f"{package[:100]!r} is not a package name")
+        raise MeshRefused(400, "bad_package", explain("%(package)s is not a package name",
+                                                      package=repr(package[:100])))
     parts = check_relative(path)
     suffix = os.path.splitext(parts[-1])[1].lower()
     if suffix not in MESH_TYPES:
-        raise MeshRefused(415, "not_a_mesh", f"only {', '.join(sorted(MESH_TYPES))} files are served")
+        raise MeshRefused(415, "not_a_mesh", explain("only %(mesh_types)s files are served",
+                                                     mesh_types=', '.join(sorted(MESH_TYPES))))
     share = os.path.realpath(share_folder(package))
     real = os.path.realpath(os.path.join(share, *parts))
     if os.path.commonpath([share, real]) != share:
-        raise MeshRefused(403, "outside_package", f"{path[:200]!r} leads outside package {package!r}'s share folder")
+        raise MeshRefused(403, "outside_package", explain("%(path)s leads outside package %(package)s's share "
+                                                          "folder",
+                                                          path=repr(path[:200]), package=repr(package)))
     try:
         stat = os.stat(real)
     except OSError:
-        raise MeshRefused(404, "no_such_mesh", f"package {package!r} has no {path[:200]!r}") from None
+        raise MeshRefused(404, "no_such_mesh", explain("package %(package)s has no %(path)s",
+                                                       package=repr(package), path=repr(path[:200]))) from None
     if not os.path.isfile(real):
-        raise MeshRefused(404, "no_such_mesh", f"{path[:200]!r} in package {package!r} is not a file")
+        raise MeshRefused(404, "no_such_mesh", explain("%(path)s in package %(package)s is not a file",
+                                                       path=repr(path[:200]), package=repr(package)))
     return MeshFile(real, MESH_TYPES[suffix], stat.st_size, stat.st_mtime_ns)
 
 

@@ -36,7 +36,7 @@ def mesh(package: str, path: str):
     try:
         found = resolve(package, path)
     except MeshRefused as exc:
-        raise ApiError(exc.status, exc.code, exc.message) from None
+        raise ApiError(exc.status, exc.code, exc.text) from None
     # A package's file does not change while it is installed; a reinstall changes size or mtime, and
     # so the ETag, and a page that reloads the model asks again (If-None-Match answers 304).
     if request.if_none_match.contains(found.etag):
@@ -58,7 +58,8 @@ def _number(name: str, code: str, default: float, low: float, high: float) -> fl
     except ValueError:
         value = math.nan
     if not math.isfinite(value) or not low <= value <= high:
-        raise ApiError(400, code, f"{name} must be a number from {low:g} to {high:g}, got {raw[:20]!r}")
+        raise ApiError(400, code, "%(name)s must be a number from %(low)s to %(high)s, got %(raw)s",
+                       name=name, low=format(low, "g"), high=format(high, "g"), raw=repr(raw[:20]))
     return value
 
 

@@ -13,6 +13,8 @@ from dataclasses import dataclass, field
 
 from lxml import etree
 
+from rover_web.web.api_messages import as_text, explain
+
 MAX_URDF_BYTES = 8 * 1024 * 1024
 _PLACE = re.compile(r"ParseError in (\S+):\s*(.*)", re.S)
 _XML_LINE = re.compile(r"line (\d+)(?:, column (\d+))?")
@@ -20,10 +22,12 @@ _XML_LINE = re.compile(r"line (\d+)(?:, column (\d+))?")
 
 class UrdfError(Exception):
     def __init__(self, message: str, line: int | None = None, column: int | None = None):
-        super().__init__(message)
-        self.message, self.line, self.column = message, line, column
+        self.text = as_text(message, {})
+        super().__init__(self.text.english())
+        self.message, self.line, self.column = self.text.english(), line, column
 
     def as_dict(self) -> dict:
+        # English: the robot's description is parsed once for every viewer, whatever their language.
         where = f"line {self.line}: " if self.line else ""
         return {"message": where + self.message, "line": self.line, "column": self.column}
 
@@ -44,7 +48,7 @@ def _tree(text: str):
         return etree.fromstring(text.encode(), parser)
     except etree.XMLSyntaxError as exc:
         line, column = exc.position if exc.position else (None, None)
-        raise UrdfError(f"not well-formed XML: {exc.msg}", line, column) from None
+        raise UrdfError(explain("not well-formed XML: %(msg)s", msg=exc.msg), line, column) from None
 
 
 def _line_of(root, place: str) -> int | None:
@@ -62,10 +66,10 @@ def _first(root, xpath: str) -> int | None:
 
 def parse(text: str) -> Model:
     if len(text.encode()) > MAX_URDF_BYTES:
-        raise UrdfError(f"the description is over {MAX_URDF_BYTES // (1024 * 1024)} MiB")
+        raise UrdfError(explain("the description is over %(value)s MiB", value=MAX_URDF_BYTES // (1024 * 1024)))
     root = _tree(text)
     if root.tag != "robot":
-        raise UrdfError(f"the root element is <{root.tag}>, a URDF's is <robot>", root.sourceline)
+        raise UrdfError(explain("the root element is <%(tag)s>, a URDF's is <robot>", tag=root.tag), root.sourceline)
     from urdf_parser_py import xml_reflection
     from urdf_parser_py.urdf import URDF
 
@@ -80,29 +84,39 @@ def parse(text: str) -> Model:
         if found:
             place, message = found.group(1), found.group(2).strip()
             line = _line_of(root, re.sub(r"\[@(\w+)\]$", "", place))
-            raise UrdfError(f"{message} (at {place})", line) from None
-        raise UrdfError(raw or type(exc).__name__) from None
+            raise UrdfError(explain("%(message)s (at %(place)s)", message=message, place=place), line) from None
+        raise UrdfError(explain("%(why)s", why=raw or type(exc).__name__)) from None
     links = [link.name for link in robot.links]
     names = set(links)
     if not links:
-        raise UrdfError("the robot has no <link>", root.sourceline)
+        raise UrdfError(explain("the robot has no <link>"), root.sourceline)
     children: dict[str, str] = {}
     joints = []
     for joint in robot.joints:
         where = f"/robot/joint[@name={_quote(joint.name)}]"
         for role, link in (("parent", joint.parent), ("child", joint.child)):
             if link not in names:
-                raise UrdfError(f"joint {joint.name!r} names {role} link {link!r}, which is not a <link>",
+                raise UrdfError(explain("joint %(name)s names %(role)s link %(link)s, which is not a <link>",
+                                        name=repr(joint.name), role=role, link=repr(link)),
                                 _first(root, where))
         if joint.child in children:
-            raise UrdfError(f"link {joint.child!r} is the child of two joints ({children[joint.child]!r} and "
-                            f"{joint.name!r})", _first(root, where))
+            raise UrdfError(
+                explain(
+                    "link %(child)s is the child of two joints (%(children)s and %(name)s)",
+                    child=repr(joint.child),
+                    children=repr(children[joint.child]),
+                    name=repr(joint.name),
+                ),
+                _first(root, where),
+            )
         children[joint.child] = joint.name
         joints.append({"name": joint.name, "type": joint.type, "parent": joint.parent, "child": joint.child})
     roots = [name for name in links if name not in children]
     if len(roots) != 1:
-        raise UrdfError("the links form no single tree: " + (f"{len(roots)} roots ({', '.join(roots[:5])})"
-                                                              if roots else "a loop, and no root"))
+        if roots:
+            raise UrdfError(explain("the links form no single tree: %(count)s roots (%(roots)s)",
+                                    count=len(roots), roots=", ".join(roots[:5])))
+        raise UrdfError(explain("the links form no single tree: a loop, and no root"))
     meshes = [m.get("filename", "") for m in root.iter("mesh")]
     return Model(robot.name, roots[0], links, joints, meshes)
 

@@ -35,37 +35,41 @@ def waypoints_from_geojson(doc: Any, max_waypoints: int) -> list[tuple[float, fl
     """(lng, lat, label) for every feature, in order; InvalidInput naming the first problem."""
     if not isinstance(doc, dict) or doc.get("type") != "FeatureCollection":
         kind = doc.get("type") if isinstance(doc, dict) else type(doc).__name__
-        raise InvalidInput(f"expected a GeoJSON FeatureCollection, got {str(kind)[:40]!r}", "bad_geojson")
+        raise InvalidInput("expected a GeoJSON FeatureCollection, got %(kind)s", "bad_geojson",
+                           kind=repr(str(kind)[:40]))
     features = doc.get("features")
     if not isinstance(features, list):
         raise InvalidInput("'features' must be a list of Point features", "bad_geojson")
     if len(features) > max_waypoints:
-        raise InvalidInput(f"the file has {len(features)} waypoints; the most a mission may hold is "
-                           f"{max_waypoints} (ROVER_WEB_MAX_WAYPOINTS)", "too_many_waypoints")
+        raise InvalidInput("the file has %(count)s waypoints; the most a mission may hold is %(max_waypoints)s "
+                           "(ROVER_WEB_MAX_WAYPOINTS)", "too_many_waypoints",
+                           count=len(features), max_waypoints=max_waypoints)
     points = []
     for i, feature in enumerate(features):
         where = f"features[{i}]"
         if not isinstance(feature, dict) or feature.get("type") != "Feature":
-            raise InvalidInput(f"{where} must be a GeoJSON Feature", "bad_geojson")
+            raise InvalidInput("%(where)s must be a GeoJSON Feature", "bad_geojson", where=where)
         geometry = feature.get("geometry")
         if not isinstance(geometry, dict) or geometry.get("type") != "Point":
             kind = geometry.get("type") if isinstance(geometry, dict) else geometry
-            raise InvalidInput(f"{where}.geometry must be a Point, got {str(kind)[:40]!r}", "bad_geojson")
+            raise InvalidInput("%(where)s.geometry must be a Point, got %(kind)s", "bad_geojson",
+                               where=where, kind=repr(str(kind)[:40]))
         coordinates = geometry.get("coordinates")
         if not isinstance(coordinates, list) or len(coordinates) not in (2, 3):
-            raise InvalidInput(f"{where}.geometry.coordinates must be [lng, lat] or [lng, lat, altitude]",
-                               "bad_geojson")
+            raise InvalidInput("%(where)s.geometry.coordinates must be [lng, lat] or [lng, lat, altitude]",
+                               "bad_geojson", where=where)
         lng = check_lng(coordinates[0], f"{where}.geometry.coordinates[0] (lng)")
         lat = check_lat(coordinates[1], f"{where}.geometry.coordinates[1] (lat)")
         if len(coordinates) == 3:  # an altitude is allowed and ignored, but it must be a number
             altitude = coordinates[2]
             if isinstance(altitude, bool) or not isinstance(altitude, (int, float)):
-                raise InvalidInput(f"{where}.geometry.coordinates[2] (altitude) must be a number", "bad_type")
+                raise InvalidInput("%(where)s.geometry.coordinates[2] (altitude) must be a number", "bad_type",
+                                   where=where)
         properties = feature.get("properties")
         if properties is None:
             properties = {}
         if not isinstance(properties, dict):
-            raise InvalidInput(f"{where}.properties must be an object or null", "bad_geojson")
+            raise InvalidInput("%(where)s.properties must be an object or null", "bad_geojson", where=where)
         key = "label" if "label" in properties else "name"
         label = check_label(properties.get(key), f"{where}.properties.{key}")
         points.append((lng, lat, label))

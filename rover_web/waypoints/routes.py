@@ -8,6 +8,7 @@ from rover_web.auth import signed_in_name
 from rover_web.core.state import current_feature, current_rover
 from rover_web.geofence import OutsideGeofence, outside_geofence_response
 from rover_web.storage.group_commit import CommitterStopped
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import error_response, json_body
 from rover_web.web.validate import InvalidInput, only_keys
 
@@ -36,8 +37,8 @@ def _audit_edit(response):
 def _position(body: dict) -> tuple[float, float]:
     for key in ("lng", "lat"):
         if key not in body:
-            raise InvalidInput(f"'{key}' is required: send {{\"lng\": <degrees east>, \"lat\": <degrees north>}}",
-                               "missing_field")
+            raise InvalidInput("'%(key)s' is required: send {\"lng\": <degrees east>, \"lat\": <degrees north>}",
+                               "missing_field", key=key)
     return check_lng(body["lng"]), check_lat(body["lat"])
 
 
@@ -46,9 +47,10 @@ def _integer(body: dict, key: str, low: int = 0) -> int | None:
         return None
     value = body[key]
     if isinstance(value, bool) or not isinstance(value, int):
-        raise InvalidInput(f"'{key}' must be an integer, got {type(value).__name__}", "bad_type")
+        raise InvalidInput("'%(key)s' must be an integer, got %(type)s", "bad_type",
+                           key=key, type=type(value).__name__)
     if value < low:
-        raise InvalidInput(f"'{key}' must be at least {low}", "out_of_range")
+        raise InvalidInput("'%(key)s' must be at least %(low)s", "out_of_range", key=key, low=low)
     return value
 
 
@@ -152,14 +154,14 @@ def import_geojson():
 @bp.errorhandler(InvalidInput)
 def _invalid(exc: InvalidInput):
     status = 409 if exc.code == "too_many_waypoints" else 400
-    return error_response(status, exc.code, str(exc))
+    return error_response(status, exc.code, text_of(exc))
 
 
 @bp.errorhandler(MissionFull)
 def _full(exc: MissionFull):
     return error_response(409, "too_many_waypoints",
-                          f"the mission may hold at most {exc.args[0]} waypoints (ROVER_WEB_MAX_WAYPOINTS); "
-                          "delete some first")
+                          "the mission may hold at most %(count)s waypoints (ROVER_WEB_MAX_WAYPOINTS); delete some "
+                          "first", count=exc.args[0])
 
 
 @bp.errorhandler(OutsideGeofence)
@@ -169,13 +171,15 @@ def _outside_geofence(exc: OutsideGeofence):
 
 @bp.errorhandler(WaypointNotFound)
 def _not_found(exc: WaypointNotFound):
-    return error_response(404, "no_such_waypoint", f"there is no waypoint with id {str(exc.args[0])[:30]}")
+    return error_response(404, "no_such_waypoint", "there is no waypoint with id %(id)s",
+                          id=str(exc.args[0])[:30])
 
 
 @bp.errorhandler(StaleRevision)
 def _stale(exc: StaleRevision):
     return error_response(409, "mission_changed",
-                          f"the mission changed since you loaded it (now revision {exc.args[0]}); reload and check it")
+                          "the mission changed since you loaded it (now revision %(revision)s); reload and check it",
+                          revision=exc.args[0])
 
 
 @bp.errorhandler(EmptyMission)

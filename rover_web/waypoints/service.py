@@ -11,6 +11,7 @@ from rover_web.core.state import Rover
 from rover_web.estop import EStopService
 from rover_web.geofence import GeofenceService, OutsideGeofence
 from rover_web.placement import tf_buffer
+from rover_web.web.api_messages import explain
 
 from .broadcaster import MissionBroadcaster
 from .gps import FixReading, GpsTrack
@@ -132,7 +133,9 @@ class WaypointsService:
         for i, (lng, lat, _label) in enumerate(points):
             refused = self.geofence.fence.refusal(lng, lat)
             if refused is not None:
-                raise OutsideGeofence(f"features[{i}]: {refused}", **refused.details, waypoint=i)
+                raise OutsideGeofence(
+                    explain("features[%(i)s]: %(refused)s", i=i, refused=refused), **refused.details, waypoint=i
+                )
         mission = self.store.replace(points)
         self.broadcaster.changed()
         return mission

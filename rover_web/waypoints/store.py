@@ -93,15 +93,18 @@ def check_lat(value: object, where: str = "lat") -> float:
 
 def _coordinate(value: object, where: str, limit: float) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise InvalidInput(f"'{where}' must be a number, got {type(value).__name__}", "bad_type")
+        raise InvalidInput("'%(where)s' must be a number, got %(type)s", "bad_type",
+                           where=where, type=type(value).__name__)
     try:
         number = float(value)
     except OverflowError:  # an integer too large for a float
-        raise InvalidInput(f"'{where}' must be between {-limit:g} and {limit:g}", "out_of_range") from None
+        raise InvalidInput("'%(where)s' must be between %(value)s and %(limit)s", "out_of_range",
+                           where=where, value=format(-limit, "g"), limit=format(limit, "g")) from None
     if not math.isfinite(number):
-        raise InvalidInput(f"'{where}' must be finite", "non_finite")
+        raise InvalidInput("'%(where)s' must be finite", "non_finite", where=where)
     if not -limit <= number <= limit:
-        raise InvalidInput(f"'{where}' must be between {-limit:g} and {limit:g}, got {number:g}", "out_of_range")
+        raise InvalidInput("'%(where)s' must be between %(value)s and %(limit)s, got %(number)s", "out_of_range",
+                           where=where, value=format(-limit, "g"), limit=format(limit, "g"), number=format(number, "g"))
     return number
 
 
@@ -109,11 +112,13 @@ def check_label(value: object, where: str = "label") -> str:
     if value is None:
         return ""
     if not isinstance(value, str):
-        raise InvalidInput(f"'{where}' must be a string, got {type(value).__name__}", "bad_type")
+        raise InvalidInput("'%(where)s' must be a string, got %(type)s", "bad_type",
+                           where=where, type=type(value).__name__)
     if len(value) > MAX_LABEL_CHARS:
-        raise InvalidInput(f"'{where}' is longer than {MAX_LABEL_CHARS} characters", "too_long")
+        raise InvalidInput("'%(where)s' is longer than %(max_label_chars)s characters", "too_long",
+                           where=where, max_label_chars=MAX_LABEL_CHARS)
     if any(ord(c) < 32 or 127 <= ord(c) < 160 or 0xD800 <= ord(c) <= 0xDFFF for c in value):
-        raise InvalidInput(f"'{where}' may not contain control characters", "bad_value")
+        raise InvalidInput("'%(where)s' may not contain control characters", "bad_value", where=where)
     return value
 
 

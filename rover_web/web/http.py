@@ -9,6 +9,7 @@ from flask import Flask, Request, current_app, jsonify, render_template, request
 from werkzeug.exceptions import HTTPException, NotFound
 from werkzeug.middleware.proxy_fix import ProxyFix
 
+from .api_messages import Text, as_text, explain
 from .validate import InvalidInput, loads_strict
 
 JSON_PREFIXES = ("/api/", "/ws/", "/stream", "/snapshot", "/metrics")  # /metrics: Prometheus gets 401, not a page
@@ -16,20 +17,29 @@ STATE_CHANGING = frozenset({"POST", "PUT", "PATCH", "DELETE"})
 
 
 class ApiError(Exception):
-    def __init__(self, status: int, code: str, message: str, retry_after_s: float | None = None):
-        super().__init__(message)
-        self.status, self.code, self.message = status, code, message
+    """A JSON 4xx/5xx: `code` an English identifier clients branch on, `message` an English msgid with
+    `%(name)s` placeholders filled from `values`, answered in the request's language
+    (api_messages.py). `message` may also be a Text another part raised (api_messages.text_of)."""
+
+    def __init__(self, status: int, code: str, message: str | Text, retry_after_s: float | None = None,
+                 **values):
+        self.text = as_text(message, values)
+        self.message = self.text.english()  # logs and str(exc) stay English
+        super().__init__(self.message)
+        self.status, self.code = status, code
         self.retry_after_s = retry_after_s
 
 
-def too_many(what: str, wait_s: float) -> ApiError:
+def too_many(what: Text, wait_s: float) -> ApiError:
     """429 with the whole seconds to wait, in the message and in Retry-After."""
     seconds = max(1, int(wait_s + 0.999))
-    return ApiError(429, "rate_limited", f"too many {what}; try again in {seconds} s", retry_after_s=seconds)
+    return ApiError(429, "rate_limited", "too many %(what)s; try again in %(seconds)s s", retry_after_s=seconds,
+                    what=what, seconds=seconds)
 
 
-def error_response(status: int, code: str, message: str):
-    response = jsonify(error=code, message=message)
+def error_response(status: int, code: str, message: str | Text, **values):
+    """The JSON error answer; its message rendered in the request's language, its code never."""
+    response = jsonify(error=code, message=as_text(message, values).translated())
     response.status_code = status
     return response
 
@@ -44,9 +54,9 @@ def json_body(required: bool = True) -> dict:
     try:
         body = loads_strict(raw)
     except InvalidInput as exc:
-        raise ApiError(400, exc.code, str(exc)) from None
+        raise ApiError(400, exc.code, exc.text) from None
     if not isinstance(body, dict):
-        raise ApiError(400, "bad_json", f"body must be a JSON object, got {type(body).__name__}")
+        raise ApiError(400, "bad_json", "body must be a JSON object, got %(type)s", type=type(body).__name__)
     return body
 
 
@@ -169,22 +179,23 @@ def _guard():
     host = request.environ.get("HTTP_HOST", "")
     if not host_is_trusted(host, config["ROVER_WEB_TRUSTED_HOSTS"]):
         return error_response(400, "untrusted_host",
-                              f"Host {host[:80]!r} is not in ROVER_WEB_TRUSTED_HOSTS; "
-                              "add it there to reach the GUI by that name")
+                              "Host %(host)s is not in ROVER_WEB_TRUSTED_HOSTS; "
+                              "add it there to reach the GUI by that name", host=repr(host[:80]))
     is_websocket = request.headers.get("Upgrade", "").lower() == "websocket"
     if request.method in STATE_CHANGING or is_websocket:
         origin = request.headers.get("Origin")
         if origin and not origin_allowed(origin, host, config["ROVER_WEB_ALLOWED_ORIGINS"]):
             return error_response(403, "foreign_origin",
-                                  f"requests from {origin[:80]} may not control this robot; "
-                                  "add it to ROVER_WEB_ALLOWED_ORIGINS")
+                                  "requests from %(origin)s may not control this robot; "
+                                  "add it to ROVER_WEB_ALLOWED_ORIGINS", origin=origin[:80])
     limit = config["ROVER_WEB_MAX_BODY_BYTES"]
     own_limit = _view_body_limit()
     if own_limit is not None:
         request.max_content_length = own_limit  # the view says why it refuses more; reading stops there
     elif request.content_length is not None and request.content_length > limit:
         # Refuse before routing or reading, whatever the route does with its body.
-        return error_response(413, "request_entity_too_large", f"request body is larger than {limit} bytes")
+        return error_response(413, "request_entity_too_large", "request body is larger than %(limit)s bytes",
+                              limit=limit)
     if (request.method in ("POST", "PUT", "PATCH") and request.mimetype != "application/json"
             and not (request.mimetype in FORM_TYPES and _view_accepts_form())
             and request.mimetype not in _view_accepts_media()):
@@ -226,6 +237,38 @@ def _not_found_page(exc: HTTPException):
         return None
 
 
+# Werkzeug's own descriptions of the errors it raises before a view runs (no route, wrong method...),
+# written here so the catalogue has them; a description a view gave (abort(404, description=Text))
+# is its own msgid.
+_WERKZEUG_TEXTS = {
+    400: explain("The browser (or proxy) sent a request that this server could not understand."),
+    404: explain("The requested URL was not found on the server. If you entered the URL manually please "
+                 "check your spelling and try again."),
+    405: explain("The method is not allowed for the requested URL."),
+    406: explain("The resource identified by the request is only capable of generating response entities "
+                 "which have content characteristics not acceptable according to the accept headers sent in "
+                 "the request."),
+    408: explain("The server closed the network connection because the browser didn't finish the request "
+                 "within the specified time."),
+    413: explain("The data value transmitted exceeds the capacity limit."),
+    415: explain("The server does not support the media type transmitted in the request."),
+    429: explain("This user has exceeded an allotted request count. Try again later."),
+    500: explain("The server encountered an internal error and was unable to complete your request. Either "
+                 "the server is overloaded or there is an error in the application."),
+    503: explain("The server is temporarily unable to service your request due to maintenance downtime or "
+                 "capacity problems. Please try again later."),
+}
+
+
+def _http_text(exc: HTTPException) -> Text:
+    if isinstance(exc.description, Text):
+        return exc.description
+    known = _WERKZEUG_TEXTS.get(exc.code or 0)
+    if known is not None and exc.description == known.msgid:
+        return known
+    return Text("%(reason)s", {"reason": exc.description or exc.name})
+
+
 def init_app(app: Flask) -> None:
     trust_proxies(app)
     app.before_request(_guard)
@@ -233,7 +276,7 @@ def init_app(app: Flask) -> None:
 
     @app.errorhandler(ApiError)
     def _api_error(exc: ApiError):
-        response = error_response(exc.status, exc.code, exc.message)
+        response = error_response(exc.status, exc.code, exc.text)
         if exc.retry_after_s is not None:
             response.headers["Retry-After"] = str(max(1, int(exc.retry_after_s + 0.999)))
         return response
@@ -243,10 +286,10 @@ def init_app(app: Flask) -> None:
         if not wants_json(request):
             return (_not_found_page(exc) if exc.code == 404 else None) or exc
         code = (exc.name or "error").lower().replace(" ", "_")
-        message = exc.description or exc.name
         if exc.code == 413:
-            message = f"request body is larger than {current_app.config['ROVER_WEB_MAX_BODY_BYTES']} bytes"
-        return error_response(exc.code or 500, code, message)
+            return error_response(413, code, "request body is larger than %(limit)s bytes",
+                                  limit=current_app.config["ROVER_WEB_MAX_BODY_BYTES"])
+        return error_response(exc.code or 500, code, _http_text(exc))
 
     @app.errorhandler(sqlite3.Error)
     def _storage(exc: sqlite3.Error):
@@ -256,7 +299,8 @@ def init_app(app: Flask) -> None:
         if getattr(exc, "sqlite_errorname", "") == "SQLITE_FULL":
             return error_response(507, "disk_full", "the disk under the database is full; nothing was stored. "
                                                     "Free space on it and try again")
-        return error_response(503, "storage_unavailable", f"the database could not be used: {exc}; nothing was stored")
+        return error_response(503, "storage_unavailable", "the database could not be used: %(why)s; nothing was stored",
+                              why=str(exc))
 
     @app.errorhandler(Exception)
     def _unexpected(exc: Exception):

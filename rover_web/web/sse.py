@@ -11,6 +11,7 @@ from flask import Blueprint, Response, request, stream_with_context
 from rover_web.auth import on_revoke
 from rover_web.core.state import current_rover
 from rover_web.events.hub import TooManyClients
+from rover_web.web.api_messages import text_of
 from rover_web.web.connection import peer_gone
 from rover_web.web.streams import held_by, stream_slot
 
@@ -27,12 +28,13 @@ def _parse_channels(raw: str, known: frozenset[str]) -> list[str]:
     channels = [c for c in (part.strip() for part in raw.split(",")) if c]
     if not channels:
         raise ApiError(400, "missing_channels",
-                       f"name channels, e.g. ?channels=status; known: {', '.join(sorted(known))}")
+                       "name channels, e.g. ?channels=status; known: %(known)s",
+                       known=', '.join(sorted(known)))
     unknown = [c for c in channels if c not in known]
     if unknown:
         raise ApiError(400, "unknown_channel",
-                       f"unknown channel(s) {', '.join(c[:32] for c in unknown[:5])}; "
-                       f"known: {', '.join(sorted(known))}")
+                       "unknown channel(s) %(value)s; known: %(known)s",
+                       value=', '.join(c[:32] for c in unknown[:5]), known=', '.join(sorted(known)))
     return channels
 
 
@@ -78,7 +80,7 @@ def events():
         subscription = hub.subscribe(channels, last_event_id)
     except TooManyClients as exc:
         slot.release()
-        raise ApiError(503, "too_many_streams", f"{exc}; close some tabs") from None
+        raise ApiError(503, "too_many_streams", "%(why)s; close some tabs", why=text_of(exc)) from None
     keepalive_s = config["ROVER_WEB_SSE_KEEPALIVE_S"]
     sock = request.environ.get("werkzeug.socket") or request.environ.get("gunicorn.socket")
     retry = f"retry: {config['ROVER_WEB_SSE_RETRY_MS']}\n\n".encode()

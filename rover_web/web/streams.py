@@ -12,6 +12,7 @@ from flask_login import current_user
 
 from rover_web.core.state import current_rover
 from rover_web.core.streams import StreamSlot, TooManyStreams
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import ApiError
 
 # Kinds that may take the reserved slots whoever asks: driving must never find the cap full.
@@ -68,7 +69,7 @@ def stream_slot(kind: str) -> StreamSlot:
         return current_rover().streams.acquire(kind, client_key(), share,
                                                config["ROVER_WEB_STREAMS_RESERVED"], _may_reserve(kind))
     except TooManyStreams as exc:
-        raise ApiError(503, "too_many_streams", str(exc)) from None
+        raise ApiError(503, "too_many_streams", text_of(exc)) from None
 
 
 def held_by(response: Response, slot: StreamSlot) -> Response:

@@ -7,23 +7,30 @@ import math
 import re
 from typing import Any
 
+from .api_messages import Text, as_text, explain
+
 
 class InvalidInput(ValueError):
-    """Input the client must fix; `code` is the short machine-readable reason."""
+    """Input the client must fix; `code` is the short machine-readable reason.
 
-    def __init__(self, message: str, code: str = "bad_request"):
-        super().__init__(message)
+    `message` is an English msgid with `%(name)s` placeholders filled from `values` (api_messages.py):
+    English in str(exc), translated in the answer (`ApiError(400, exc.code, exc.text)`).
+    """
+
+    def __init__(self, message: str | Text, code: str = "bad_request", **values: Any):
+        self.text = as_text(message, values)
+        super().__init__(self.text.english())
         self.code = code
 
 
 def _refuse_constant(name: str) -> Any:
-    raise InvalidInput(f"{name} is not allowed: numbers must be finite", "non_finite")
+    raise InvalidInput("%(name)s is not allowed: numbers must be finite", "non_finite", name=name)
 
 
 def _finite_float(text: str) -> float:
     value = float(text)
     if not math.isfinite(value):  # 1e400 parses to inf
-        raise InvalidInput(f"{text} is out of range: numbers must be finite", "non_finite")
+        raise InvalidInput("%(number)s is out of range: numbers must be finite", "non_finite", number=text)
     return value
 
 
@@ -41,7 +48,7 @@ def loads_strict(data: bytes | str) -> Any:
     except InvalidInput:
         raise
     except (ValueError, UnicodeDecodeError) as exc:
-        raise InvalidInput(f"body is not valid JSON: {exc}", "bad_json") from None
+        raise InvalidInput("body is not valid JSON: %(why)s", "bad_json", why=str(exc)) from None
     except RecursionError:
         raise InvalidInput("body is nested too deeply", "bad_json") from None
 
@@ -61,18 +68,20 @@ def number(obj: dict, key: str, *, low: float | None = None, high: float | None 
     if key not in obj or obj[key] is None and default is not ...:
         if default is not ...:
             return default
-        raise InvalidInput(f"'{key}' is required", "missing_field")
+        raise InvalidInput("'%(key)s' is required", "missing_field", key=key)
     value = obj[key]
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise InvalidInput(f"'{key}' must be a number, got {type(value).__name__}", "bad_type")
+        raise InvalidInput("'%(key)s' must be a number, got %(type)s", "bad_type", key=key, type=type(value).__name__)
     try:
         value = float(value)
     except OverflowError:  # an integer of hundreds of digits: JSON allows it, a float cannot hold it
-        raise InvalidInput(f"'{key}' is out of range: an integer too large for a number", "out_of_range") from None
+        raise InvalidInput("'%(key)s' is out of range: an integer too large for a number", "out_of_range",
+                           key=key) from None
     if not math.isfinite(value):
-        raise InvalidInput(f"'{key}' must be finite", "non_finite")
+        raise InvalidInput("'%(key)s' must be finite", "non_finite", key=key)
     if low is not None and value < low or high is not None and value > high:
-        raise InvalidInput(f"'{key}' must be between {low:g} and {high:g}, got {value:g}", "out_of_range")
+        raise InvalidInput("'%(key)s' must be between %(low)s and %(high)s, got %(value)s", "out_of_range",
+                           key=key, low=format(low, "g"), high=format(high, "g"), value=format(value, "g"))
     return value
 
 
@@ -80,22 +89,23 @@ def text(obj: dict, key: str, *, max_len: int = 200, default: Any = ..., choices
     if key not in obj or obj[key] is None and default is not ...:
         if default is not ...:
             return default
-        raise InvalidInput(f"'{key}' is required", "missing_field")
+        raise InvalidInput("'%(key)s' is required", "missing_field", key=key)
     value = obj[key]
     if not isinstance(value, str):
-        raise InvalidInput(f"'{key}' must be a string, got {type(value).__name__}", "bad_type")
+        raise InvalidInput("'%(key)s' must be a string, got %(type)s", "bad_type", key=key, type=type(value).__name__)
     if len(value) > max_len:
-        raise InvalidInput(f"'{key}' is longer than {max_len} characters", "too_long")
+        raise InvalidInput("'%(key)s' is longer than %(max_len)s characters", "too_long", key=key, max_len=max_len)
     if choices is not None and value not in choices:
-        raise InvalidInput(f"'{key}' must be one of {', '.join(choices)}; got {value[:40]!r}", "bad_value")
+        raise InvalidInput("'%(key)s' must be one of %(choices)s; got %(value)s", "bad_value",
+                           key=key, choices=", ".join(choices), value=repr(value[:40]))
     return value
 
 
 def only_keys(obj: dict, allowed: set[str]) -> None:
     unknown = sorted(set(obj) - allowed)
     if unknown:
-        raise InvalidInput(f"unknown field(s): {', '.join(unknown)}; allowed: {', '.join(sorted(allowed))}",
-                           "unknown_field")
+        raise InvalidInput("unknown field(s): %(unknown)s; allowed: %(allowed)s", "unknown_field",
+                           unknown=", ".join(unknown), allowed=", ".join(sorted(allowed)))
 
 
 _TOPIC_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
@@ -110,13 +120,16 @@ def topic_name(value: Any, field: str = "topic") -> str:
     mean nothing to a browser and are refused.
     """
     if not isinstance(value, str) or not value.strip():
-        raise InvalidInput(f"'{field}' is required: a ROS topic name such as /camera/image_raw", "missing_field")
+        raise InvalidInput("'%(field)s' is required: a ROS topic name such as /camera/image_raw", "missing_field",
+                           field=field)
     name = value
     if name != name.strip():
         # Not trimmed: a name with a newline or space at an end is a mistake (or a probe) to refuse.
-        raise InvalidInput(f"'{field}' {value.strip()[:80]!r} has spaces or line breaks around it", "bad_topic")
+        raise InvalidInput("'%(field)s' %(value)s has spaces or line breaks around it", "bad_topic",
+                           field=field, value=repr(value.strip()[:80]))
     if len(name) > TOPIC_MAX_LEN:
-        raise InvalidInput(f"'{field}' is longer than {TOPIC_MAX_LEN} characters", "bad_topic")
+        raise InvalidInput("'%(field)s' is longer than %(max_len)s characters", "bad_topic",
+                           field=field, max_len=TOPIC_MAX_LEN)
     if not name.startswith("/"):
         name = "/" + name
     tokens = name[1:].split("/")
@@ -124,10 +137,11 @@ def topic_name(value: Any, field: str = "topic") -> str:
         if not _TOPIC_TOKEN.match(token):
             shown = value.strip()[:80]
             if token == "":
-                why = "has an empty part ('//' or a trailing '/')"
+                why = explain("has an empty part ('//' or a trailing '/')")
             elif token[0].isdigit():
-                why = f"has a part starting with a digit ({token[:20]!r})"
+                why = explain("has a part starting with a digit (%(part)s)", part=repr(token[:20]))
             else:
-                why = "may only contain letters, digits, '_' and '/'"
-            raise InvalidInput(f"'{field}' {shown!r} is not a valid ROS topic name: it {why}", "bad_topic")
+                why = explain("may only contain letters, digits, '_' and '/'")
+            raise InvalidInput("'%(field)s' %(name)s is not a valid ROS topic name: it %(why)s", "bad_topic",
+                               field=field, name=repr(shown), why=why)
     return name

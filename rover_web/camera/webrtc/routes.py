@@ -7,6 +7,7 @@ from flask import Blueprint, Response, jsonify, request
 from rover_web.auth import AuthService, current_identity, may, on_revoke, signed_in_name
 from rover_web.camera.service import StreamRefused
 from rover_web.core.state import current_feature
+from rover_web.web.api_messages import text_of
 from rover_web.web.http import ApiError, accepts_media, error_response
 from rover_web.web.streams import opening
 from rover_web.web.validate import InvalidInput
@@ -21,12 +22,12 @@ STATUS = {"unknown_topic": 404, "cannot_subscribe": 400}
 
 @bp.errorhandler(InvalidInput)
 def invalid_input(exc: InvalidInput):
-    return error_response(400, exc.code, str(exc))
+    return error_response(400, exc.code, text_of(exc))
 
 
 @bp.errorhandler(StreamRefused)
 def refused(exc: StreamRefused):
-    return error_response(STATUS.get(exc.code, 503), exc.code, str(exc))
+    return error_response(STATUS.get(exc.code, 503), exc.code, text_of(exc))
 
 
 @bp.post("/api/camera/whep")

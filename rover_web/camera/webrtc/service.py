@@ -39,6 +39,7 @@ from rover_web.config import ConfigError
 from rover_web.core.leases import Closed, Full, Leases, ShareUsed
 from rover_web.core.state import Rover
 from rover_web.core.streams import StreamSlot
+from rover_web.web.api_messages import explain, request_catalogues, text_of
 from rover_web.web.validate import InvalidInput
 
 from . import frames
@@ -90,6 +91,7 @@ class WhepSession:
     state: str = "new"
     last_connected: float | None = None
     ended: str | None = None  # why it ended
+    catalogues: tuple | None = None  # the offer's language, for the data channel's error frames
     remb_bps: int | None = None  # the browser's latest estimate, unclamped
     link_share: float = 1.0  # of that estimate, what the video may use (ROVER_WEB_WEBRTC_LINK_SHARE)
     loss_keyframes: int = 0  # keyframes sent instead of resending what could not help (feedback.py)
@@ -163,8 +165,9 @@ def _check_fingerprints(offer: str) -> None:
 
     for media in SessionDescription.parse(offer).media:
         if not any(f.algorithm in X509_DIGEST_ALGORITHMS for f in media.dtls.fingerprints):
-            raise InvalidInput(f"the offer's {media.kind} section has no DTLS fingerprint this server can check "
-                               f"({', '.join(X509_DIGEST_ALGORITHMS)})", "bad_sdp")
+            raise InvalidInput("the offer's %(kind)s section has no DTLS fingerprint this server can check "
+                               "(%(x509_digest_algorithms)s)", "bad_sdp",
+                               kind=media.kind, x509_digest_algorithms=', '.join(X509_DIGEST_ALGORITHMS))
 
 
 class WebRtcService:
@@ -277,7 +280,8 @@ class WebRtcService:
         and gives it back when it ends, or at once when it cannot be made."""
         key = self.camera.key_for(args)
         if len(offer) > MAX_OFFER_CHARS:
-            raise InvalidInput(f"the offer is longer than {MAX_OFFER_CHARS} characters", "bad_sdp")
+            raise InvalidInput("the offer is longer than %(max_offer_chars)s characters", "bad_sdp",
+                               max_offer_chars=MAX_OFFER_CHARS)
         if not offer.lstrip().startswith("v=0"):
             raise InvalidInput("the body is not an SDP offer (it must start with v=0)", "bad_sdp")
         if "\nm=video " not in offer.replace("\r\n", "\n"):
@@ -292,22 +296,38 @@ class WebRtcService:
                 session.producer = self.producers.acquire(key, client, None if client is None
                                                           else self.producers_per_client)
             except Closed:
-                raise Unavailable("the server is shutting down", "shutting_down") from None
+                raise Unavailable(explain("the server is shutting down"), "shutting_down") from None
             except ShareUsed as exc:
-                raise Unavailable(f"{exc} different WebRTC camera streams (ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT); "
-                                  "close one first", "too_many_producers") from None
+                raise Unavailable(
+                    explain(
+                        "%(why)s different WebRTC camera streams (ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT); close one first",
+                        why=text_of(exc),
+                    ),
+                    "too_many_producers",
+                ) from None
             except Full:
-                raise Unavailable(f"{len(self.producers)} different WebRTC camera streams are converted already "
-                                  "(ROVER_WEB_CAMERA_MAX_PRODUCERS); view one of them", "too_many_producers") from None
+                raise Unavailable(
+                    explain(
+                        "%(count)s different WebRTC camera streams are converted already "
+                        "(ROVER_WEB_CAMERA_MAX_PRODUCERS); view one of them",
+                        count=len(self.producers),
+                    ),
+                    "too_many_producers",
+                ) from None
             except Exception as exc:
                 log.exception("cannot subscribe to %s", key.topic)
-                raise CannotSubscribe(f"cannot subscribe to {key.topic}: {exc}", "cannot_subscribe") from None
+                raise CannotSubscribe(
+                    explain("cannot subscribe to %(topic)s: %(why)s", topic=key.topic, why=text_of(exc)),
+                    "cannot_subscribe",
+                ) from None
             try:
                 answer = self.loop.run(self._negotiate(session, offer), NEGOTIATE_TIMEOUT_S)
             except LoopStopped:
-                raise Unavailable("the server is shutting down", "shutting_down") from None
+                raise Unavailable(explain("the server is shutting down"), "shutting_down") from None
             except TimeoutError:
-                raise Unavailable("the WebRTC loop did not answer the offer in time", "webrtc_timeout") from None
+                raise Unavailable(
+                    explain("the WebRTC loop did not answer the offer in time"), "webrtc_timeout"
+                ) from None
         except BaseException:
             self._abandon(session)
             raise
@@ -318,19 +338,22 @@ class WebRtcService:
         try:
             with self._lock:
                 if self._closed:
-                    raise Unavailable("the server is shutting down", "shutting_down")
+                    raise Unavailable(explain("the server is shutting down"), "shutting_down")
                 if len(self._sessions) >= self.max_viewers:
-                    raise Unavailable(f"{len(self._sessions)} WebRTC viewers are connected already "
-                                      f"(ROVER_WEB_WEBRTC_MAX_VIEWERS); watch the MJPEG stream instead: "
-                                      f"GET /stream?topic={key.topic}", "too_many_webrtc_viewers")
+                    raise Unavailable(explain("%(count)s WebRTC viewers are connected already "
+                                              "(ROVER_WEB_WEBRTC_MAX_VIEWERS); watch the MJPEG stream instead: GET "
+                                              "/stream?topic=%(topic)s",
+                                              count=len(self._sessions), topic=key.topic), "too_many_webrtc_viewers")
                 # Each session has its own encoder and a place of few: one client must leave the
                 # others some, whatever its share of the much larger stream cap.
                 held = 0 if slot.client is None else sum(s.client == slot.client for s in self._sessions.values())
                 if held >= self.viewers_per_client:
-                    raise Unavailable(f"this client holds {held} WebRTC viewer places already, its share "
-                                      f"(ROVER_WEB_WEBRTC_VIEWERS_PER_CLIENT); close one, or watch the MJPEG "
-                                      f"stream instead: GET /stream?topic={key.topic}", "too_many_webrtc_viewers")
-                session = WhepSession(secrets.token_urlsafe(16), user, role, may_operate, key, slot)
+                    raise Unavailable(explain("this client holds %(held)s WebRTC viewer places already, its share "
+                                              "(ROVER_WEB_WEBRTC_VIEWERS_PER_CLIENT); close one, or watch the "
+                                              "MJPEG stream instead: GET /stream?topic=%(topic)s",
+                                              held=held, topic=key.topic), "too_many_webrtc_viewers")
+                session = WhepSession(secrets.token_urlsafe(16), user, role, may_operate, key, slot,
+                                      catalogues=request_catalogues())
                 self._sessions[session.id] = session
                 return session
         except BaseException:
@@ -374,8 +397,8 @@ class WebRtcService:
             try:
                 await pc.setRemoteDescription(RTCSessionDescription(sdp=_without_mdns(offer), type="offer"))
             except Exception as exc:  # aiortc raises ValueError, KeyError, IndexError... for bad SDP
-                raise InvalidInput(f"the SDP offer could not be used: {str(exc)[:200] or type(exc).__name__}",
-                                   "bad_sdp") from None
+                raise InvalidInput("the SDP offer could not be used: %(value)s",
+                                   "bad_sdp", value=str(exc)[:200] or type(exc).__name__) from None
             _check_fingerprints(offer)
             video = [t for t in pc.getTransceivers() if t.kind == "video"]
             if not video or video[0].direction not in ("recvonly", "sendrecv"):
@@ -390,7 +413,8 @@ class WebRtcService:
                 answer = await pc.createAnswer()
                 await pc.setLocalDescription(answer)
             except Exception as exc:
-                raise InvalidInput(f"no answer can be made to this offer: {str(exc)[:200]}", "bad_sdp") from None
+                raise InvalidInput("no answer can be made to this offer: %(why)s", "bad_sdp",
+                                   why=str(exc)[:200]) from None
         return filter_candidates(pc.localDescription.sdp, self.host_addresses)
 
     def _on_datachannel(self, session: WhepSession, channel) -> None:
@@ -401,14 +425,17 @@ class WebRtcService:
             channel.close()
             return
         if not session.may_operate or session.teleop is not None:
-            why = (f"driving needs the operator role; {session.user} is a {session.role}" if not session.may_operate
-                   else "this session has a teleop channel already")
-            channel.send(json.dumps({"type": "error", "error": "forbidden", "status": 403, "message": why}))
+            why = (explain("driving needs the operator role; %(name)s is a %(role)s", name=session.user,
+                           role=session.role) if not session.may_operate
+                   else explain("this session has a teleop channel already"))
+            channel.send(json.dumps({"type": "error", "error": "forbidden", "status": 403,
+                                     "message": why.translated(session.catalogues)}))
             channel.close()
             return
         teleop = self.rover.feature(TeleopService)
         glue = TeleopChannel(channel, teleop.controller, session.user, teleop.hello(), teleop.max_frame_bytes,
                              call_soon=self.loop.call_soon, call_later=self.loop.loop.call_later, pool=self._teleop)
+        glue.session.catalogues = session.catalogues
         session.teleop = glue
         channel.on("message", glue.on_message)
         channel.on("close", glue.close)
