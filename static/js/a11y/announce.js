@@ -5,15 +5,25 @@
 // coalesced: at most one message every THROTTLE_MS, each source's latest state only, and a state
 // that came back to what was last said before it was spoken is not said at all. An e-stop change
 // jumps the queue (its banner is also role="alert").
+import { _ } from '../core/i18n.js';
+
 const THROTTLE_MS = 2000;
+
+// The state words as the pills show them (static/js/live/live.js says the same words).
+const WORDS = {
+  connecting: _('connecting'), live: _('live'), reconnecting: _('reconnecting'), lost: _('lost'), ok: _('ok'),
+  degraded: _('degraded'), stale: _('stale'), no_data: _('no data'), unknown: _('unknown'),
+};
+const word = (v) => WORDS[v] || v.replace('_', ' ');
 
 // [element id, attribute, how it is said]
 const SOURCES = [
-  ['link-server', 'data-state', (v) => `Server link ${v}`],
-  ['link-robot', 'data-state', (v) => `Robot ${v.replace('_', ' ')}`],
-  ['link-errors', 'data-state', (v) => (v === 'errors' ? 'Errors on the robot in the last minute' : 'No errors on the robot')],
-  ['estop', 'data-engaged', (v) => (v === 'yes' ? 'E-stop engaged' : 'E-stop released')],
-  ['teleop-link', 'data-state', (v) => `Drive link ${v}`],
+  ['link-server', 'data-state', (v) => _('Server link %(state)s', { state: word(v) })],
+  ['link-robot', 'data-state', (v) => _('Robot %(state)s', { state: word(v) })],
+  ['link-errors', 'data-state', (v) => (v === 'errors' ? _('Errors on the robot in the last minute')
+    : _('No errors on the robot'))],
+  ['estop', 'data-engaged', (v) => (v === 'yes' ? _('E-stop engaged') : _('E-stop released'))],
+  ['teleop-link', 'data-state', (v) => _('Drive link %(state)s', { state: word(v) })],
 ];
 
 const region = document.getElementById('a11y-announcer');

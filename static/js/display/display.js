@@ -4,6 +4,7 @@
 // browser's own record), and, signed in, the user's preferences on the robot, which follow them to
 // any browser. A new theme applies at once; a new language needs the page rendered again.
 import { api } from '../core/api.js';
+import { _ } from '../core/i18n.js';
 import { applyTheme, rememberChoice } from './choices.js';
 
 const menu = document.getElementById('display-menu');
@@ -21,7 +22,7 @@ function setup() {
       await api('PUT', '/api/me/preferences', { [key]: value }, { root: true });
     } catch (err) {
       // Still kept by this browser: say so rather than pretend the robot has it.
-      note.textContent = `Kept in this browser only: the robot refused to save it (${err.message}).`;
+      note.textContent = _('Kept in this browser only: the robot refused to save it (%(reason)s).', { reason: err.message });
       throw err;
     }
   }
@@ -48,7 +49,7 @@ function setup() {
   language.addEventListener('change', () => {
     saving = save('language', language.value);
     if (pointer) reload();
-    else note.textContent = 'Press Enter to show the page in this language.';
+    else note.textContent = _('Press Enter to show the page in this language.');
   });
 
   // Closes on Escape (focus back on its button) or a click elsewhere, like the page menu.
