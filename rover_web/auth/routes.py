@@ -7,9 +7,11 @@ import socket
 from urllib.parse import unquote, urlsplit
 
 from flask import Blueprint, g, jsonify, make_response, redirect, render_template, request, session, url_for
+from flask_babel import gettext
 from flask_login import current_user, login_user, logout_user
 
 from rover_web.core.state import current_feature, current_rover
+from rover_web.i18n import N_
 from rover_web.web.http import ApiError, accepts_form, error_response, json_body, wants_json
 from rover_web.web.validate import InvalidInput, only_keys, text
 
@@ -152,11 +154,21 @@ def _login_refused(as_json: bool, status: int, code: str, message: str, username
     if as_json:
         response = error_response(status, code, message)
     else:
-        html = _login_page(next_path, message, username)
+        html = _login_page(next_path, _page_message(code, message, retry_after_s), username)
         response = make_response(html, status, {"Content-Type": "text/html; charset=utf-8"})
     if retry_after_s is not None:
         response.headers["Retry-After"] = str(max(1, int(retry_after_s + 0.999)))
     return response
+
+
+def _page_message(code: str, message: str, retry_after_s: float | None) -> str:
+    """The sign-in page's words for a refusal, in the page's language (the JSON answer keeps `message`)."""
+    if code == "too_many_attempts":
+        return gettext("too many sign-in attempts: try again in %(seconds)s s", seconds=f"{retry_after_s or 0:.0f}")
+    known = {"missing_field": N_("enter a user name and a password"),
+             "busy": N_("the server is checking other sign-ins: try again in a second"),
+             "bad_credentials": N_("wrong user name or password")}
+    return gettext(known[code]) if code in known else message
 
 
 # --- sessions ---

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from flask import Blueprint, render_template
+from flask_babel import gettext
 
 from rover_web.core.state import current_rover
 from rover_web.layouts import LayoutService
@@ -25,7 +26,8 @@ def dashboard():
                            battery=rover.hub.latest("battery"), layout=layout, layout_id=layout_id,
                            layouts=service.store.list(), cards=cards, missing=missing, channels=channels,
                            uses_uplot=any(c.type in ("plot", "link") for c in cards),
-                           card_types=catalogue())
+                           card_types=[{**t, "title": gettext(t["title"]), "help": gettext(t["help"])}
+                                       for t in catalogue()])
 
 
 @bp.get("/status")
@@ -37,4 +39,4 @@ def status_page():
 @bp.app_context_processor
 def layout_context():
     rover = current_rover()
-    return {"nav_links": rover.nav_links, "rover_config": rover.config}
+    return {"nav_links": rover.nav_links, "rover_config": rover.config}  # labels: message ids (base.html translates)
