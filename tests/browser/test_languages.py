@@ -24,9 +24,9 @@ pytestmark = pytest.mark.browser
 LANGUAGES = ("es", "ja")
 PAGES = ["/", "/status", "/livemap", "/topics", "/panels", "/waypoints", "/logs", "/diagnostics", "/ros", "/robots",
          "/recordings", "/plot", "/tf", "/3d", "/api/docs", "/login", "/no/such/page"]
-# Not interface words: code, and data shown as it is (frame ids, topic names, the frame fields of the TF
-# lookup, a robot's name: the one robot of a test app is called "robot"); and a mission control panel's own labels, which its operator writes in the panel's TOML
-# (docs/panels.md), in the language of their choice.
+# Not interface words: code, and data shown as it is (frame ids, topic names, the frame fields of the
+# TF lookup, a robot's name: the one robot of a test app is called "robot"); and a mission control
+# panel's own labels, which its operator writes in the panel's TOML (docs/panels.md).
 NOT_INTERFACE = ", ".join([
     "code", "pre", "kbd", "samp", "script", "style", "select#view3d-fixed", "select#plot-topic", "select#camera-topic",
     "form.tf-lookup input", ".cp-displays dt", ".cp-control", ".cp-input label", "[data-panel-summary] > .muted",
