@@ -164,7 +164,7 @@ def _login_refused(as_json: bool, status: int, code: str, message: str, username
 def _page_message(code: str, message: str, retry_after_s: float | None) -> str:
     """The sign-in page's words for a refusal, in the page's language (the JSON answer keeps `message`)."""
     if code == "too_many_attempts":
-        return gettext("too many sign-in attempts: try again in %(seconds)s s", seconds=f"{retry_after_s or 0:.0f}")
+        return gettext("too many sign-in attempts: try again in %(seconds)s s", seconds=round(retry_after_s or 0))
     known = {"missing_field": N_("enter a user name and a password"),
              "busy": N_("the server is checking other sign-ins: try again in a second"),
              "bad_credentials": N_("wrong user name or password")}

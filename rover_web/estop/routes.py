@@ -89,7 +89,7 @@ def login_estop():
         if as_json:
             raise too_many("e-stop engages from the sign-in page, and every robot is already engaged", wait_s)
         return _login_page(429, gettext("every robot's e-stop is already engaged, and this address pressed too "
-                                        "often: try again in %(seconds)s s", seconds=f"{wait_s:.0f}"),
+                                        "often: try again in %(seconds)s s", seconds=round(wait_s)),
                            retry_after_s=wait_s)
     response = _engage_all(f"sign-in page ({address})"[:NAME_MAX_LEN])
     if as_json:
