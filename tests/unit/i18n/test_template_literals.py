@@ -20,9 +20,10 @@ from rover_web.config import ROOT
 
 TEMPLATES = ROOT / "templates"
 GETTEXT = {"_", "gettext", "ngettext", "pgettext", "npgettext"}
-# Attributes a person reads or hears (and `value` of a button-like input).
+# Attributes a person reads or hears (and `value` of a button-like input); data-readonly-reason is
+# the sentence the page's scripts show on a control a viewer may not use.
 READ_ATTRIBUTES = {"title", "aria-label", "aria-description", "aria-roledescription", "aria-valuetext", "placeholder",
-                   "alt", "label"}
+                   "alt", "label", "data-readonly-reason"}
 # Element contents that are code, keys or data, never prose (the contract keeps ROS names, key names
 # and identifiers untranslated): no word in them is looked at.
 VERBATIM = {"code", "kbd", "samp", "script", "style", "pre"}
