@@ -4,6 +4,7 @@ POST /login/estop (the sign-in page's engage-only button)."""
 from __future__ import annotations
 
 from flask import Blueprint, abort, jsonify, make_response, render_template, request
+from flask_babel import gettext
 
 from rover_web.auth import require_role, signed_in_name
 from rover_web.core.state import current_feature, current_rover
@@ -88,13 +89,13 @@ def login_estop():
     if wait_s > 0 and fleet_estop.all_engaged:
         if as_json:
             raise too_many(explain("e-stop engages from the sign-in page, and every robot is already engaged"), wait_s)
-        return _login_page(429, "every robot's e-stop is already engaged, and this address pressed too often: "
-                                f"try again in {wait_s:.0f} s",
+        return _login_page(429, gettext("every robot's e-stop is already engaged, and this address pressed too "
+                                        "often: try again in %(seconds)s s", seconds=round(wait_s)),
                            retry_after_s=wait_s)
     response = _engage_all(f"sign-in page ({address})"[:NAME_MAX_LEN])
     if as_json:
         return response
-    return _login_page(200, "E-stop engaged on every robot. Releasing it needs an operator to sign in.")
+    return _login_page(200, gettext("E-stop engaged on every robot. Releasing it needs an operator to sign in."))
 
 
 @bp.post("/estop")

@@ -12,6 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from rover_web.i18n import N_
+
 # The end of the string, in a JSON Schema (ECMA) pattern that Python's re reads the same: `$` alone
 # also matches before a trailing newline in Python, so {"topic": "/a\n"} was stored (issue 40), and
 # ECMA has no \Z. "Nothing follows" is a negative lookahead on any character.
@@ -46,47 +48,48 @@ class CardType:
 
 
 CARDS: dict[str, CardType] = {c.name: c for c in (
-    CardType("drive", "Drive", "panels/teleop.html", panel="panels/teleop.html", size=(4, 7), min_size=(3, 4),
-             help="joystick, keys and gamepad"),
-    CardType("robot", "Robot", "panels/odom.html", panel="panels/odom.html", size=(4, 3), min_size=(2, 2),
-             help="speed, position and battery"),
-    CardType("camera", "Camera", "panels/camera.html", panel="panels/camera.html", size=(6, 6), min_size=(3, 3),
-             settings=settings({"topic": TOPIC_OR_DEFAULT}), help="any image topic, live or snapshots"),
-    CardType("gps_map", "GPS map", "panels/waypoints.html", panel="panels/waypoints.html", size=(8, 7),
-             min_size=(4, 4), help="waypoints, the mission and the geofence"),
-    CardType("livemap", "Live map", "panels/livemap.html", panel="panels/livemap.html", size=(4, 4),
-             help="the floorplan with the robot on it"),
-    CardType("scan_the_code", "Scan the Code", "panels/scan_the_code.html", panel="panels/scan_the_code.html",
-             size=(4, 6), min_size=(3, 3), help="the light buoy's sequence"),
-    CardType("panel", "Mission panel", "panels/panels.html", panel="panels/panels.html", size=(4, 4),
+    CardType("drive", N_("Drive"), "panels/teleop.html", panel="panels/teleop.html", size=(4, 7), min_size=(3, 4),
+             help=N_("joystick, keys and gamepad")),
+    CardType("robot", N_("Robot"), "panels/odom.html", panel="panels/odom.html", size=(4, 3), min_size=(2, 2),
+             help=N_("speed, position and battery")),
+    CardType("camera", N_("Camera"), "panels/camera.html", panel="panels/camera.html", size=(6, 6), min_size=(3, 3),
+             settings=settings({"topic": TOPIC_OR_DEFAULT}), help=N_("any image topic, live or snapshots")),
+    CardType("gps_map", N_("GPS map"), "panels/waypoints.html", panel="panels/waypoints.html", size=(8, 7),
+             min_size=(4, 4), help=N_("waypoints, the mission and the geofence")),
+    CardType("livemap", N_("Live map"), "panels/livemap.html", panel="panels/livemap.html", size=(4, 4),
+             help=N_("the floorplan with the robot on it")),
+    CardType("scan_the_code", N_("Scan the Code"), "panels/scan_the_code.html", panel="panels/scan_the_code.html",
+             size=(4, 6), min_size=(3, 3), help=N_("the light buoy's sequence")),
+    CardType("panel", N_("Mission panel"), "panels/panels.html", panel="panels/panels.html", size=(4, 4),
              settings=settings({"panel": {"type": "string", "maxLength": 64, "pattern": r"^([a-z][a-z0-9_-]*)?" + END,
                                           "description": "a panel's id; \"\" for every panel"}}),
-             help="a mission control panel's light and status"),
-    CardType("plot", "Plot", "cards/plot.html", once=False, channels=("plot",), size=(6, 4), min_size=(3, 3),
+             help=N_("a mission control panel's light and status")),
+    CardType("plot", N_("Plot"), "cards/plot.html", once=False, channels=("plot",), size=(6, 4), min_size=(3, 3),
              settings=settings({"series": {"type": "array", "minItems": 1, "maxItems": 4,
                                            "items": settings({"topic": TOPIC, "field": FIELD_PATH},
                                                              ("topic", "field"))},
                                 "window_s": {"enum": [10, 30, 60, 300]}}, ("series",)),
-             help="chosen numeric fields over time"),
-    CardType("echo", "Topic echo", "cards/echo.html", once=False, size=(4, 4),
-             settings=settings({"topic": TOPIC}, ("topic",)), help="the latest message of a topic"),
-    CardType("diagnostics", "Diagnostics", "panels/diagnostics.html", panel="panels/diagnostics.html",
-             size=(4, 4), help="the worst level of each piece of hardware"),
-    CardType("logs", "Logs", "cards/logs.html", once=False, channels=("rosout",), size=(6, 4), min_size=(3, 2),
+             help=N_("chosen numeric fields over time")),
+    CardType("echo", N_("Topic echo"), "cards/echo.html", once=False, size=(4, 4),
+             settings=settings({"topic": TOPIC}, ("topic",)), help=N_("the latest message of a topic")),
+    CardType("diagnostics", N_("Diagnostics"), "panels/diagnostics.html", panel="panels/diagnostics.html",
+             size=(4, 4), help=N_("the worst level of each piece of hardware")),
+    CardType("logs", N_("Logs"), "cards/logs.html", once=False, channels=("rosout",), size=(6, 4), min_size=(3, 2),
              settings=settings({"level": {"enum": LEVELS},
                                 "lines": {"type": "integer", "minimum": 5, "maximum": 100}}),
-             help="the newest /rosout lines at or above a level"),
-    CardType("node", "Node", "cards/node.html", size=(4, 4), help="rover_web's node and its topics"),
-    CardType("link", "Link", "cards/link.html", size=(6, 3), min_size=(3, 2),
-             help="round trip to the server and the age of the robot's newest message"),
+             help=N_("the newest /rosout lines at or above a level")),
+    CardType("node", N_("Node"), "cards/node.html", size=(4, 4), help=N_("rover_web's node and its topics")),
+    CardType("link", N_("Link"), "cards/link.html", size=(6, 3), min_size=(3, 2),
+             help=N_("round trip to the server and the age of the robot's newest message")),
     # One per layout: each is a WebGL context, and browsers allow a page only a few (about 16).
-    CardType("view3d", "3D view", "cards/view3d.html", channels=("view3d", "view3d_robot", "view3d_markers"),
+    CardType("view3d", N_("3D view"), "cards/view3d.html", channels=("view3d", "view3d_robot", "view3d_markers"),
              settings=settings({"fixed": {"enum": ["map", "odom", "robot"]}}), size=(6, 6), min_size=(3, 3),
-             help="the robot's model moved by TF, its markers and point cloud"),
+             help=N_("the robot's model moved by TF, its markers and point cloud")),
 )}
 
 
 def catalogue() -> list[dict]:
-    """The card types as the editor offers them (the page embeds this as JSON)."""
+    """The card types as the editor offers them (the page embeds this as JSON). Title and help are the
+    English message ids: the page translates them (web/pages.py)."""
     return [{"name": c.name, "title": c.title, "help": c.help, "settings": c.settings, "once": c.once,
              "size": list(c.size), "min_size": list(c.min_size)} for c in CARDS.values()]

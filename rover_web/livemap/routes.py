@@ -6,6 +6,7 @@ import hashlib
 from urllib.parse import quote
 
 from flask import Blueprint, Response, abort, jsonify, redirect, render_template, request, url_for
+from flask_babel import gettext
 
 from rover_web.core.state import current_feature
 from rover_web.geofence import OutsideGeofence, outside_geofence_response
@@ -93,7 +94,7 @@ def livemap_page(name: str):
     try:
         live = feature.live_map(name, None)
     except UnknownMap:
-        abort(404, description=f"There is no map named {name[:80]!r}.")
+        abort(404, description=gettext("There is no map named %(name)s.", name=repr(name[:80])))
     page = {
         "map": map_summary(live.definition),
         "map_state": live.map_state,

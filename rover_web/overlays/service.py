@@ -25,6 +25,7 @@ import numpy as np
 
 from rover_web.config import ConfigError
 from rover_web.core.state import Rover
+from rover_web.i18n import N_
 from rover_web.placement import CONFIGURED, IDENTITY, MAP, TF, MapPlacer, Planar, Unplaceable, heading, tf_buffer
 from rover_web.ros import cdr
 from rover_web.ros.convert import yaw_from_quaternion
@@ -338,11 +339,11 @@ class OverlayService:
 
     def layers(self) -> list[dict]:
         """The map page's layer list, in drawing order from the bottom."""
-        return [{"name": "costmap", "label": "Costmaps", "topics": self.costmap_topics},
-                {"name": "path", "label": "Recent path", "topics": []},
-                {"name": "footprint", "label": "Footprint", "topics": self.counts["footprint"].topics},
-                {"name": "markers", "label": "Markers", "topics": self.counts["markers"].topics},
-                {"name": "scan", "label": "Laser scan", "topics": self.counts["scan"].topics}]
+        return [{"name": "costmap", "label": N_("Costmaps"), "topics": self.costmap_topics},
+                {"name": "path", "label": N_("Recent path"), "topics": []},
+                {"name": "footprint", "label": N_("Footprint"), "topics": self.counts["footprint"].topics},
+                {"name": "markers", "label": N_("Markers"), "topics": self.counts["markers"].topics},
+                {"name": "scan", "label": N_("Laser scan"), "topics": self.counts["scan"].topics}]
 
     def summary(self) -> dict:
         with self._placed_lock:

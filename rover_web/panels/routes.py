@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from flask import Blueprint, abort, current_app, jsonify, render_template, request
+from flask_babel import gettext
 
 from rover_web.auth import signed_in_name
 from rover_web.core.state import current_feature
@@ -53,7 +54,7 @@ def panels_page():
 def panel_page(panel_id: str):
     svc = service()
     if panel_id not in svc.specs:
-        abort(404, f"no panel {panel_id[:40]!r}")
+        abort(404, gettext("There is no panel %(name)s.", name=repr(panel_id[:40])))
     return render_template("control_panels.html", panels=_page_panels([panel_id]), single=svc.specs[panel_id],
                            log_shown=current_app.config["ROVER_WEB_PANELS_LOG_SHOWN"])
 

@@ -6,6 +6,7 @@ import json
 import time
 
 from flask import Blueprint, Response, jsonify, render_template, request
+from flask_babel import gettext
 
 from rover_web.auth import AuthService, may, signed_in_name
 from rover_web.core.state import current_feature, current_rover
@@ -63,12 +64,13 @@ def _is_admin() -> bool:
 
 
 def _write_block() -> str | None:
-    """Why this page's user may not set, call or send, or None: for disabled buttons (the server decides)."""
+    """Why this page's user may not set, call or send, or None: for disabled buttons (the server decides).
+    In the page's language: only the page shows it."""
     admin = current_feature(RosAdmin)
     if admin.mode == "read-only":
-        return "ROS admin is read-only on this server (ROVER_WEB_ROS_ADMIN=read-only)"
+        return gettext("ROS admin is read-only on this server (ROVER_WEB_ROS_ADMIN=read-only)")
     if not _is_admin():
-        return "setting parameters, calling services and sending goals needs the admin role"
+        return gettext("setting parameters, calling services and sending goals needs the admin role")
     return None
 
 

@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import math
 
+from rover_web.i18n import N_
 from rover_web.ros import cdr
 from rover_web.ros.convert import stamp_to_float, yaw_from_quaternion
 
 ODOMETRY = "nav_msgs/msg/Odometry"
 BATTERY_STATE = "sensor_msgs/msg/BatteryState"
 # sensor_msgs/BatteryState power_supply_status
-SUPPLY_STATUS = {1: "charging", 2: "discharging", 3: "not charging", 4: "full"}
+# Message ids: the page translates them where it shows them (templates/panels/odom.html).
+SUPPLY_STATUS = {1: N_("charging"), 2: N_("discharging"), 3: N_("not charging"), 4: N_("full")}
 
 
 def battery_summary(msg) -> dict:
@@ -21,7 +23,7 @@ def battery_summary(msg) -> dict:
     return {
         "percent": known(msg.percentage, 100.0, 1),
         "voltage": known(msg.voltage),
-        "status": SUPPLY_STATUS.get(msg.power_supply_status, "unknown"),
+        "status": SUPPLY_STATUS.get(msg.power_supply_status, N_("unknown")),
         "stamp": stamp_to_float(msg.header.stamp),
     }
 

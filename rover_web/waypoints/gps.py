@@ -13,9 +13,11 @@ import threading
 from collections import deque
 from dataclasses import dataclass
 
+from rover_web.i18n import N_
+
 EARTH_RADIUS_M = 6371008.8
 STATUS_NO_FIX = -1  # sensor_msgs/NavSatStatus.STATUS_NO_FIX
-STATUS_NAMES = {-1: "no fix", 0: "fix", 1: "SBAS fix", 2: "GBAS fix"}
+STATUS_NAMES = {-1: N_("no fix"), 0: N_("fix"), 1: N_("SBAS fix"), 2: N_("GBAS fix")}  # message ids: pages translate
 # A word per NavSatStatus the page styles by: unaugmented, satellite-based augmentation (WAAS,
 # EGNOS), ground-based augmentation (DGPS, RTK).
 QUALITY = {-1: "none", 0: "fix", 1: "sbas", 2: "gbas"}
@@ -42,11 +44,11 @@ def distance_m(lng1: float, lat1: float, lng2: float, lat2: float) -> float:
 
 def no_fix_reason(reading: FixReading) -> str | None:
     if reading.status < 0:
-        return "no satellite lock"
+        return N_("no satellite lock")
     if not (math.isfinite(reading.lat) and math.isfinite(reading.lng)):
-        return "position is not a finite number"
+        return N_("position is not a finite number")
     if not (-90.0 <= reading.lat <= 90.0 and -180.0 <= reading.lng <= 180.0):
-        return "position is outside the valid latitude/longitude range"
+        return N_("position is outside the valid latitude/longitude range")
     return None
 
 

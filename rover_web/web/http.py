@@ -6,6 +6,7 @@ import sqlite3
 from urllib.parse import urlsplit
 
 from flask import Flask, Request, current_app, jsonify, render_template, request
+from flask_babel import gettext
 from werkzeug.exceptions import HTTPException, NotFound
 from werkzeug.middleware.proxy_fix import ProxyFix
 
@@ -229,7 +230,7 @@ def _not_found_page(exc: HTTPException):
     """
     why = exc.description
     if not why or why == NotFound.description:
-        why = f"There is no page at {request.path[:200]}."
+        why = gettext("There is no page at %(path)s.", path=request.path[:200])
     try:
         return render_template("not_found.html", why=why), 404
     except Exception:  # noqa: BLE001 - whatever broke drawing it, the answer stays a 404

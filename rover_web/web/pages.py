@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 from flask import Blueprint, render_template
+from flask_babel import gettext
 
 from rover_web.core.state import current_rover
 from rover_web.layouts import LayoutService
 from rover_web.layouts.cards import catalogue
+from rover_web.layouts.defaults import DEFAULTS
 from rover_web.layouts.page import place
 
 from .status import build_status
@@ -23,9 +25,17 @@ def dashboard():
     cards, channels, missing = place(rover, layout)
     return render_template("dashboard.html", status=build_status(rover), odom=rover.hub.latest("odom"),
                            battery=rover.hub.latest("battery"), layout=layout, layout_id=layout_id,
-                           layouts=service.store.list(), cards=cards, missing=missing, channels=channels,
+                           layouts=[{**row, "name": shown_name(row["name"])} for row in service.store.list()],
+                           layout_name=shown_name(layout["name"]), cards=cards, missing=missing, channels=channels,
                            uses_uplot=any(c.type in ("plot", "link") for c in cards),
-                           card_types=catalogue())
+                           card_types=[{**t, "title": gettext(t["title"]), "help": gettext(t["help"])}
+                                       for t in catalogue()])
+
+
+def shown_name(name: str) -> str:
+    """A layout's name as the page shows it: a built-in layout's name is a message id (layouts/defaults.py),
+    kept by a copy of it; any other name is the user's own."""
+    return gettext(name) if name in {d["name"] for d in DEFAULTS.values()} else name
 
 
 @bp.get("/status")
@@ -37,4 +47,4 @@ def status_page():
 @bp.app_context_processor
 def layout_context():
     rover = current_rover()
-    return {"nav_links": rover.nav_links, "rover_config": rover.config}
+    return {"nav_links": rover.nav_links, "rover_config": rover.config}  # labels: message ids (base.html translates)
