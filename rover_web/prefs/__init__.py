@@ -16,7 +16,7 @@ from flask import Flask
 from rover_web.core.state import Rover
 
 from . import routes
-from .service import LANGUAGES, THEMES, PreferenceService, effective
+from .service import LANGUAGE_NAMES, LANGUAGES, THEMES, PreferenceService, effective
 from .store import PreferenceStore
 
 __all__ = ["init_app", "PreferenceService", "effective", "LANGUAGES", "THEMES"]
@@ -26,4 +26,4 @@ def init_app(app: Flask, rover: Rover) -> None:
     """After auth (the choices are the signed-in user's); `rover` holds the app's database."""
     rover.add_feature(PreferenceService(PreferenceStore(rover.db)))
     app.register_blueprint(routes.bp)
-    app.context_processor(lambda: {"preferences": effective()})
+    app.context_processor(lambda: {"preferences": effective(), "language_names": LANGUAGE_NAMES})

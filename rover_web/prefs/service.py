@@ -18,6 +18,8 @@ from .store import PreferenceStore
 THEMES = ("auto", "dark", "daylight")
 # The shipped catalogues (translations/); "auto" is the browser's Accept-Language.
 LANGUAGES = ("auto", "en", "es", "ja")
+# Each language named in itself (its autonym), as a language picker shows it: never translated.
+LANGUAGE_NAMES = {"en": "English", "es": "Español", "ja": "日本語"}
 ALLOWED = {"theme": THEMES, "language": LANGUAGES}
 DEFAULTS = {"theme": "auto", "language": "auto"}
 COOKIES = {"theme": "rover_web_theme", "language": "rover_web_lang"}
