@@ -75,6 +75,24 @@ def test_translations_keep_the_placeholders(lang):
     assert problems == []
 
 
+@pytest.mark.parametrize("lang", SHIPPED)
+def test_a_message_id_has_one_translation_across_the_files(lang):
+    """The pages (messages.po), the browser code (browser.po) and the API (api.po) share message ids:
+    one word must not read two ways on one screen (the start would keep one and warn about the other)."""
+    from babel.messages.pofile import read_po
+
+    seen, clashes = {}, []
+    for path in sorted((ROOT / "translations" / lang / "LC_MESSAGES").glob("*.po")):
+        with path.open("rb") as f:
+            for message in read_po(f, locale=lang):
+                if not message.id or not message.string:
+                    continue
+                first = seen.setdefault(message.id, (path.name, message.string))
+                if first[1] != message.string:
+                    clashes.append(f"{message.id!r}: {first[0]} {first[1]!r}, {path.name} {message.string!r}")
+    assert clashes == []
+
+
 def write_po(path, lang, entries):
     header = (f'msgid ""\nmsgstr ""\n"Language: {lang}\\n"\n"Content-Type: text/plain; charset=utf-8\\n"\n'
               '"Plural-Forms: nplurals=3; plural=(n == 1 ? 0 : n != 0 && n % 1000000 == 0 ? 1 : 2);\\n"\n\n')
