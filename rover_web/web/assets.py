@@ -271,7 +271,9 @@ if __name__ == "__main__":
     # scripts/test.sh do), so that start, or two test workers at once, do not compress it themselves.
     started = time.monotonic()
     static = Path(__file__).resolve().parents[2] / "static"
-    store = build_dir_for(static, os.environ.get("ROVER_WEB_STATIC_BUILD_DIR"))
-    store.mkdir(parents=True, exist_ok=True)
-    built = build(static, store)
-    print(f"static files: {len(built.hashed)} hashed and compressed in {store} ({time.monotonic() - started:.1f} s)")
+    # Not named `store`: this block runs at module level, and build() calls the function of that name.
+    store_dir = build_dir_for(static, os.environ.get("ROVER_WEB_STATIC_BUILD_DIR"))
+    store_dir.mkdir(parents=True, exist_ok=True)
+    built = build(static, store_dir)
+    print(f"static files: {len(built.hashed)} hashed and compressed in {store_dir} "
+          f"({time.monotonic() - started:.1f} s)")
