@@ -274,6 +274,9 @@ def action_server():
     yield from closing_factory(ActionServerPeer)
 
 
+SIM_START_S = 60  # a loaded 2-core machine starts one in a few seconds
+
+
 class SimProcess:
     """`python -m rover_web.sim` (or one part, e.g. module="rover_web.sim.drone") in its own process."""
 
@@ -284,16 +287,23 @@ class SimProcess:
         self.proc = subprocess.Popen([sys.executable, "-m", module, *args], cwd=ROOT,
                                      env=subprocess_env(**env), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                      text=True)
-        line = self.proc.stdout.readline()
-        if "simulator running" not in line:
-            raise RuntimeError(f"simulator did not start: {line}{self.proc.stdout.read()}")
+        # Fast DDS may log before the ready line (a shared-memory port another process left locked, say):
+        # wait for the line itself, for a bounded time; reading "to the end" of a running simulator
+        # would wait for ever.
         self.output: list[str] = []
-        self._drainer = threading.Thread(target=self._drain, daemon=True)
+        ready = threading.Event()
+        self._drainer = threading.Thread(target=self._drain, args=(ready,), daemon=True)
         self._drainer.start()
+        if not ready.wait(SIM_START_S):
+            self.proc.kill()
+            self.proc.wait(5)
+            raise RuntimeError(f"simulator did not start within {SIM_START_S} s: {''.join(self.output)[-2000:]}")
 
-    def _drain(self) -> None:
+    def _drain(self, ready: threading.Event) -> None:
         for line in self.proc.stdout:
             self.output.append(line)
+            if "simulator running" in line:
+                ready.set()
 
     def stop(self) -> int:
         import signal as _signal

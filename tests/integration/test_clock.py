@@ -90,6 +90,7 @@ WALL_CLOCK_ALLOWED = {
     "geofence/service.py": "`since` shown to people",
     "geofence/store.py": "when the fence was saved",
     "layouts/store.py": "when a layout was last changed, shown to people (updated_at)",
+    "prefs/store.py": "when a user's choices last changed (updated_at)",
     "panels/oplog.py": "when a log line was written",
     "plot/routes.py": "the plot's time axis is wall time, as its CSV export shows it",
     "plot/service.py": "when a sample arrived, for the plot's time axis",

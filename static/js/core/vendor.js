@@ -41,13 +41,26 @@ export function loadStyle(url) {
   document.head.append(el);
 }
 
+// A page with its own <script> for the library (the plot page, the hub) names no URL: wait for that
+// script, which may run after this module (a page's bundle is in its head, the library's <script>
+// at the end of its body), instead of asking for "undefined".
+function loadOrAwait(url, name, global) {
+  if (url) return loadScript(url);
+  const own = document.querySelector(`script[src*="${name}"]`);
+  if (!own || window[global]) return Promise.resolve();
+  return new Promise((resolve, reject) => {
+    own.addEventListener('load', () => resolve(), { once: true });
+    own.addEventListener('error', () => reject(new Error(_('%(url)s did not load', { url: own.src }))), { once: true });
+  });
+}
+
 // uPlot (window.uPlot), for the dashboard's plot cards and link plot; the plot page has its own <script>.
 export async function loadUplot() {
   if (window.uPlot) return window.uPlot;
   const { uplotJs, uplotCss } = document.body.dataset;
   await afterLive();
   loadStyle(uplotCss);
-  await loadScript(uplotJs);
+  await loadOrAwait(uplotJs, 'uPlot', 'uPlot');
   return window.uPlot;
 }
 
@@ -57,6 +70,6 @@ export async function loadMaplibre() {
   const { maplibreJs, maplibreCss } = document.body.dataset;
   await afterLive();
   loadStyle(maplibreCss);
-  await loadScript(maplibreJs);
+  await loadOrAwait(maplibreJs, 'maplibre-gl', 'maplibregl');
   return window.maplibregl;
 }

@@ -101,7 +101,7 @@ export function attachNav2(S, { redraw, say }) {
       const name = document.createElement('span');
       name.textContent = node.node;
       const state = document.createElement('b');
-      state.textContent = node.state;
+      state.textContent = node.state === 'unknown' ? _('unknown') : node.state;  // lifecycle states stay ROS's words
       li.append(name, ' ', state);
       return li;
     }));

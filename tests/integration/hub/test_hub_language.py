@@ -17,5 +17,5 @@ def test_the_hub_page_is_in_the_users_language(hub_app):  # noqa: F811
     assert sign_in(client, "viewer").status_code == 303
     assert client.put("/api/me/preferences", json={"language": "ja"}).status_code == 200
     page = client.get("/robots").get_data(as_text=True)  # the saved choice wins over the cookie
-    assert re.search(r'<html lang="ja" data-catalogue="/static/i18n/ja\.[0-9a-f]{12}\.json">', page)
+    assert re.search(r'<html lang="ja" data-theme="[a-z]+" data-catalogue="/static/i18n/ja\.[0-9a-f]{12}\.json">', page)
     assert "全停止" in page and "まだロボットを受信していません。" in page and "No robot heard yet." not in page

@@ -26,6 +26,15 @@ def installs(tmp_path: Path, script: str, *args: str) -> list[str]:
     # test of its own (tests/unit/test_interfaces.py); here it only has to be called.
     (tmp_path / "scripts" / "build_interfaces.sh").write_text('#!/usr/bin/env bash\necho "$0 $*" >> built\n')
     (tmp_path / "scripts" / "build_interfaces.sh").chmod(0o755)
+    # esbuild (the page bundles) is here already, at the pinned version: no npm install in a test.
+    version = next(line for line in (ROOT / "rover_web" / "web" / "bundles.py").read_text().splitlines()
+                   if line.startswith("ESBUILD_VERSION = "))
+    (tmp_path / "rover_web" / "web").mkdir(parents=True, exist_ok=True)
+    (tmp_path / "rover_web" / "web" / "bundles.py").write_text(version + "\n")
+    esbuild = tmp_path / ".tools" / "esbuild" / "node_modules" / "@esbuild" / "linux-x64" / "bin" / "esbuild"
+    esbuild.parent.mkdir(parents=True, exist_ok=True)
+    esbuild.write_text(f'#!/usr/bin/env bash\necho {version.split(chr(34))[1]}\n')
+    esbuild.chmod(0o755)
     venv = tmp_path / ".venv" / "bin"
     venv.mkdir(parents=True, exist_ok=True)
     (venv / "python").write_text(FAKE_PYTHON)
