@@ -80,3 +80,18 @@ def test_a_warm_reload_asks_for_no_static_file(live_server, browser, caplog, pat
         assert [u for u in asked if "/static/" in u] == [], asked
     finally:
         context.close()
+
+
+def test_with_scripts_off_the_drive_cards_thumb_estop_engages_too(live_server, browser):
+    """The touch layout's second E-STOP, under the driving thumb, is the header form's own button:
+    it works before any script runs (a slow link, a translated page waiting for its catalogue)."""
+    context = browser.new_context(java_script_enabled=False, viewport={"width": 390, "height": 844}, has_touch=True)
+    try:
+        page = context.new_page()
+        page.goto(live_server.url + "/")
+        page.locator("#teleop-estop").click()
+        page.wait_for_selector("#estop-engaged-page", timeout=10000)
+    finally:
+        context.close()
+    state = requests.get(live_server.url + "/api/estop", timeout=5).json()
+    assert state["engaged"] is True and state["via"] == "form"
