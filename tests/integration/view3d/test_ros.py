@@ -74,7 +74,7 @@ def test_a_cloud_is_thinned_to_the_bound_with_its_extent_kept(live_server_factor
     # nothing newer: 204 after the wait, with the sequence the page has
     again = requests.get(server.url + "/api/3d/cloud", params={"after": seq, "wait": 0.3}, timeout=5)
     assert again.status_code in (200, 204)
-    assert wait_until(lambda: robot(server)["cloud"]["skipped"].get("no_xyz"), 10, "the bad cloud counted")
+    assert wait_until(lambda: robot(server)["cloud"]["skipped"].get("no_xyz"), 30, "the bad cloud counted")
 
 
 def test_a_waiting_cloud_request_holds_a_stream_slot(live_server_factory):
