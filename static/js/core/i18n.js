@@ -55,16 +55,18 @@ if (url) {
   }
 }
 
-const numberFormats = new Map();
-function numberFormat(options) {
-  const key = JSON.stringify(options);
-  let made = numberFormats.get(key);
-  if (!made) {
-    made = new Intl.NumberFormat(locale, options);
-    numberFormats.set(key, made);
-  }
-  return made;
+// Intl formatters are costly to make and the pages ask for the same few again and again: one per
+// distinct set of options, kept.
+function formatterCache(Make) {
+  const made = new Map();
+  return (options) => {
+    const key = JSON.stringify(options);
+    if (!made.has(key)) made.set(key, new Make(locale, options));
+    return made.get(key);
+  };
 }
+const numberFormat = formatterCache(Intl.NumberFormat);
+const dateFormat = formatterCache(Intl.DateTimeFormat);
 
 // `%(name)s` takes the value as text, `%(name)d` a whole number in the locale's digits and grouping
 // (as Flask-Babel's format_number would), `%%` is a percent sign. A name not given stays as written,
@@ -152,17 +154,6 @@ export function formatUnit(value, unit, digits = undefined) {
     } catch { /* an Intl without this unit: the symbol below */ }
   }
   return `${numberFormat(fixed).format(number)}${UNSPACED.has(unit) ? '' : ' '}${unit}`;
-}
-
-const dateFormats = new Map();
-function dateFormat(options) {
-  const key = JSON.stringify(options);
-  let made = dateFormats.get(key);
-  if (!made) {
-    made = new Intl.DateTimeFormat(locale, options);
-    dateFormats.set(key, made);
-  }
-  return made;
 }
 
 function asDate(value) {
