@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from flask import Blueprint, jsonify
+from flask import Blueprint, g, jsonify
 
 from rover_web.auth.identity import signed_in_name
 from rover_web.core.state import current_feature
@@ -30,6 +30,7 @@ def set_preferences():
         raise ApiError(409, "no_user", "sign-in is off or you are not signed in: these choices are kept by the "
                                        "browser (the page stores them itself), not on the robot")
     saved = current_feature(PreferenceService).store.update(user, changes)
+    g.pop("rover_web_preferences", None)  # what this request renders from now on is the new choice
     return jsonify(saved=saved, user=user)
 
 

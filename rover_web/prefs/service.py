@@ -7,7 +7,7 @@ read, never trusted beyond the allowed values.
 
 from __future__ import annotations
 
-from flask import request
+from flask import g, request
 
 from rover_web.auth.identity import signed_in_name
 from rover_web.core.state import NotSetUp, current_feature
@@ -61,10 +61,15 @@ def from_cookies() -> dict:
 
 
 def effective() -> dict:
-    """The request's choices: defaults, under the browser's cookies, under the signed-in user's own."""
-    try:
-        service = current_feature(PreferenceService)
-    except NotSetUp:  # a page of an app without users (none so far); the browser's choices alone
-        service = None
-    saved = service.for_user(signed_in_name()) if service is not None else {}
-    return {**DEFAULTS, **from_cookies(), **saved}
+    """The request's choices: defaults, under the browser's cookies, under the signed-in user's own.
+
+    Read once a request (kept on flask.g): the language selector, the page's context and an API
+    error's message all ask, and a signed-in user's choices are a database read."""
+    if "rover_web_preferences" not in g:
+        try:
+            service = current_feature(PreferenceService)
+        except NotSetUp:  # a page of an app without users (none so far); the browser's choices alone
+            service = None
+        saved = service.for_user(signed_in_name()) if service is not None else {}
+        g.rover_web_preferences = {**DEFAULTS, **from_cookies(), **saved}
+    return dict(g.rover_web_preferences)
