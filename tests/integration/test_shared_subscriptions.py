@@ -19,17 +19,24 @@ def odom(x: float) -> dict:
     return {"header": {"frame_id": "odom"}, "pose": {"pose": {"position": {"x": x}, "orientation": {"w": 1.0}}}}
 
 
-def test_a_shared_raw_subscription_is_taken_off_the_executor_and_serves_every_reader(ros_peer):
-    runtime = RosRuntime("shared_taker_test")
-    runtime.start()
+def readers():
+    """What two readers of one shared subscription received, the threads they ran on, and reader(name)."""
     got: dict[str, list] = {"a": [], "b": []}
-    threads = set()
+    threads: set[str] = set()
 
     def reader(name):
         def on_raw(raw: bytes) -> None:
             threads.add(threading.current_thread().name)
             got[name].append(raw)
         return on_raw
+
+    return got, threads, reader
+
+
+def test_a_shared_raw_subscription_is_taken_off_the_executor_and_serves_every_reader(ros_peer):
+    runtime = RosRuntime("shared_taker_test")
+    runtime.start()
+    got, threads, reader = readers()
 
     try:
         assert runtime.subscribe(ODOM, "/shared_odom", reader("a"), qos=10, raw=True, share=True) is None
@@ -65,14 +72,7 @@ def test_a_shared_raw_subscription_can_stay_on_the_executor(ros_peer):
     """taker=False (the markers: heavy callbacks now and then): one subscription, on the executor, for both."""
     runtime = RosRuntime("shared_executor_test")
     runtime.start()
-    got: dict[str, list] = {"a": [], "b": []}
-    threads = set()
-
-    def reader(name):
-        def on_raw(raw: bytes) -> None:
-            threads.add(threading.current_thread().name)
-            got[name].append(raw)
-        return on_raw
+    got, threads, reader = readers()
 
     try:
         runtime.subscribe(ODOM, "/shared_slow", reader("a"), qos=10, raw=True, share=True, taker=False)
