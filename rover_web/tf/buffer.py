@@ -14,7 +14,7 @@ Why the maths is hand-written: the target is a lookup through a 10-frame chain i
 ``Rotation`` costs about 9 µs to build from a quaternion and 25 µs per product, transforms3d is
 numpy calls of about 3-5 µs each; a 10-link chain through either lands at 100-300 µs. The same
 product on Python floats costs about 1 µs, and a whole 10-link lookup about 12 µs (p50). The maths
-is a dozen lines (a quaternion product, a rotation of a vector, slerp); tests/unit/tf/ checks it
+is a dozen lines (a quaternion product, a rotation of a vector, slerp; transform.py); tests/unit/tf/ checks it
 against 4x4 matrices and slerp from scipy.spatial.transform, the oracle. ``Transform.apply_many``
 is the one place numpy pays off (thousands of points), so it uses it.
 
@@ -28,25 +28,19 @@ import math
 import threading
 import time
 from bisect import bisect_left
-from dataclasses import dataclass
-
-import numpy as np
 
 from rover_web.web.api_messages import as_text, explain
+
+from .transform import NLERP_DOT, Quaternion, Transform, Vector, compose, invert, product
 
 # tf2's limits: a quaternion whose squared norm is off 1 by more than this is refused
 # (TF_DENORMALIZED_QUATERNION); a walk longer than this means a loop.
 QUATERNION_TOLERANCE = 1e-5
 MAX_GRAPH_DEPTH = 1000
-# Above this dot product (two rotations 1e-3 rad apart or closer) slerp's sin(theta) is too small to
-# divide by; a normalised lerp there is within 1e-11 rad of it.
-NLERP_DOT = 1.0 - 1e-7
 MAX_PATHS = 4096  # (target, source) pairs whose path is kept; past it the cache starts again
 MAX_FRAMES = 10_000  # a robot has hundreds; a buggy publisher stamping ids with a counter is held here
 KINDS = ("unknown_frame", "not_connected", "extrapolation_past", "extrapolation_future", "invalid")
 
-Quaternion = tuple[float, float, float, float]
-Vector = tuple[float, float, float]
 
 
 class TfError(Exception):
@@ -58,138 +52,6 @@ class TfError(Exception):
         self.kind = kind
         self.message = self.text.english()
         self.detail = detail
-
-
-# --- maths on tuples (see the module docstring for why not a library) -------------------------------
-
-def _qmul(a: Quaternion, b: Quaternion) -> Quaternion:
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
-    return (aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-            aw * bw - ax * bx - ay * by - az * bz)
-
-
-def _rotate(q: Quaternion, x: float, y: float, z: float) -> Vector:
-    # v + 2w(q×v) + 2 q×(q×v): two cross products, no matrix
-    qx, qy, qz, qw = q
-    tx = 2.0 * (qy * z - qz * y)
-    ty = 2.0 * (qz * x - qx * z)
-    tz = 2.0 * (qx * y - qy * x)
-    return (x + qw * tx + (qy * tz - qz * ty),
-            y + qw * ty + (qz * tx - qx * tz),
-            z + qw * tz + (qx * ty - qy * tx))
-
-
-def _compose(ta: Vector, qa: Quaternion, tb: Vector, qb: Quaternion) -> tuple[Vector, Quaternion]:
-    """(ta, qa) ∘ (tb, qb): apply b, then a."""
-    rx, ry, rz = _rotate(qa, tb[0], tb[1], tb[2])
-    return (rx + ta[0], ry + ta[1], rz + ta[2]), _qmul(qa, qb)
-
-
-def _invert(t: Vector, q: Quaternion) -> tuple[Vector, Quaternion]:
-    qi = (-q[0], -q[1], -q[2], q[3])
-    x, y, z = _rotate(qi, t[0], t[1], t[2])
-    return (-x, -y, -z), qi
-
-
-def _product(values: list[tuple[Vector, Quaternion]], lo: int, hi: int) -> tuple[Vector, Quaternion]:
-    """values[hi-1] ∘ ... ∘ values[lo]: a frame's way up to the common ancestor, as one transform.
-
-    The same maths as _compose, written out in one loop over locals: a lookup composes up to
-    ten links and the function calls were a third of its time."""
-    if lo >= hi:
-        return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)
-    (tx, ty, tz), (qx, qy, qz, qw) = values[lo]
-    for i in range(lo + 1, hi):
-        (ax, ay, az), (px, py, pz, pw) = values[i]  # the parent's link: applied after what we have
-        # rotate (tx, ty, tz) by p, then add the parent's translation
-        cx = 2.0 * (py * tz - pz * ty)
-        cy = 2.0 * (pz * tx - px * tz)
-        cz = 2.0 * (px * ty - py * tx)
-        tx, ty, tz = (tx + pw * cx + (py * cz - pz * cy) + ax,
-                      ty + pw * cy + (pz * cx - px * cz) + ay,
-                      tz + pw * cz + (px * cy - py * cx) + az)
-        qx, qy, qz, qw = (pw * qx + px * qw + py * qz - pz * qy,
-                          pw * qy - px * qz + py * qw + pz * qx,
-                          pw * qz + px * qy - py * qx + pz * qw,
-                          pw * qw - px * qx - py * qy - pz * qz)
-    return (tx, ty, tz), (qx, qy, qz, qw)
-
-
-def slerp(a: Quaternion, b: Quaternion, r: float) -> Quaternion:
-    """Spherical interpolation along the shorter arc (tf2 flips b when the dot product is negative)."""
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
-    dot = ax * bx + ay * by + az * bz + aw * bw
-    if dot < 0.0:
-        bx, by, bz, bw, dot = -bx, -by, -bz, -bw, -dot
-    if dot > NLERP_DOT:
-        # nearly the same rotation: sin(theta) -> 0; a normalised lerp is within 1e-11 rad of slerp here
-        x, y, z, w = ax + r * (bx - ax), ay + r * (by - ay), az + r * (bz - az), aw + r * (bw - aw)
-        n = math.sqrt(x * x + y * y + z * z + w * w)
-        return (x / n, y / n, z / n, w / n)
-    theta = math.acos(dot)
-    s = math.sin(theta)
-    wa = math.sin((1.0 - r) * theta) / s
-    wb = math.sin(r * theta) / s
-    return (wa * ax + wb * bx, wa * ay + wb * by, wa * az + wb * bz, wa * aw + wb * bw)
-
-
-def yaw_of(q: Quaternion) -> float:
-    x, y, z, w = q
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
-@dataclass(frozen=True, slots=True)
-class Transform:
-    """Maps points given in ``source`` into ``target`` (tf2's lookupTransform(target, source))."""
-
-    translation: tuple[float, float, float]
-    rotation: tuple[float, float, float, float]  # x, y, z, w (unit)
-    stamp_ns: int = 0
-
-    @classmethod
-    def identity(cls, stamp_ns: int = 0) -> Transform:
-        return cls((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0), stamp_ns)
-
-    def apply(self, x: float, y: float, z: float = 0.0) -> tuple[float, float, float]:
-        rx, ry, rz = _rotate(self.rotation, x, y, z)
-        t = self.translation
-        return (rx + t[0], ry + t[1], rz + t[2])
-
-    def matrix(self) -> np.ndarray:
-        """The 3x3 rotation matrix (for callers that transform many points themselves)."""
-        x, y, z, w = self.rotation
-        return np.array((
-            (1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)),
-            (2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)),
-            (2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)),
-        ))
-
-    def apply_many(self, xs, ys, zs=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        xs = np.asarray(xs, dtype=float)
-        ys = np.asarray(ys, dtype=float)
-        zs = np.zeros_like(xs) if zs is None else np.asarray(zs, dtype=float)
-        m = self.matrix()
-        t = self.translation
-        return (m[0, 0] * xs + m[0, 1] * ys + m[0, 2] * zs + t[0],
-                m[1, 0] * xs + m[1, 1] * ys + m[1, 2] * zs + t[1],
-                m[2, 0] * xs + m[2, 1] * ys + m[2, 2] * zs + t[2])
-
-    @property
-    def yaw(self) -> float:
-        return yaw_of(self.rotation)
-
-    def inverse(self) -> Transform:
-        t, q = _invert(self.translation, self.rotation)
-        return Transform(t, q, self.stamp_ns)
-
-    def compose(self, other: Transform) -> Transform:
-        """self ∘ other: ``other`` first. The stamp is self's."""
-        t, q = _compose(self.translation, self.rotation, other.translation, other.rotation)
-        return Transform(t, q, self.stamp_ns)
 
 
 # --- the frame table ---------------------------------------------------------------------------------
@@ -413,10 +275,10 @@ class TfBuffer:
                     raise self._extrapolation(v[0], stamp, v[1], f, target, source)
                 values.append(v)
         # composition outside the lock: values are immutable tuples
-        ts, qs = _product(values, 0, s_len)
-        tt, qt = _product(values, s_len, len(values))
-        ti, qi = _invert(tt, qt)
-        t, q = _compose(ti, qi, ts, qs)
+        ts, qs = product(values, 0, s_len)
+        tt, qt = product(values, s_len, len(values))
+        ti, qi = invert(tt, qt)
+        t, q = compose(ti, qi, ts, qs)
         return Transform(t, q, stamp)
 
     def _path(self, target: str, source: str) -> tuple[list[_Frame], int]:
