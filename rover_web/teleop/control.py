@@ -166,8 +166,7 @@ class TeleopController:
                     now = None  # dropped, and not measured either
                     self.stats["out_of_order_dropped"] += 1
                     raise Refused("stale_seq", explain("frame %(seq)s dropped: a newer frame from this socket came "
-                                                       "first",
-                                                       seq=seq))
+                                                       "first", seq=seq))
                 command = self._drive(session, linear, angular, epoch, late_s, now)
                 new_source = source != session.source  # logged once per change, not per frame
                 session.source = source
@@ -199,27 +198,15 @@ class TeleopController:
             session.armed = True
         if epoch != session.epoch:
             self.stats["stale_dropped"] += 1
-            raise Refused(
-                "stale_epoch",
-                explain(
-                    "frame for epoch %(epoch)s dropped: the robot was stopped "
-                    "(%(last_stop_reason)s); send epoch %(epoch2)s to drive again",
-                    epoch=epoch,
-                    last_stop_reason=self._last_stop_reason(),
-                    epoch2=session.epoch,
-                ),
-                epoch=session.epoch,
-            )
+            raise Refused("stale_epoch", explain("frame for epoch %(epoch)s dropped: the robot was stopped "
+                                                 "(%(last_stop_reason)s); send epoch %(epoch2)s to drive again",
+                                                 epoch=epoch, last_stop_reason=self._last_stop_reason(),
+                                                 epoch2=session.epoch), epoch=session.epoch)
         if late_s >= self.deadman_max_s:  # its input is past the bound already (ramp.expired)
             self.stats["late_dropped"] += 1
-            raise Refused(
-                "late_frame",
-                explain(
-                    "frame dropped: it arrived %(value)s ms late, past the %(value2)s ms any input may drive for",
-                    value=format(1000 * late_s, ".0f"),
-                    value2=format(1000 * self.deadman_max_s, ".0f"),
-                ),
-            )
+            raise Refused("late_frame", explain("frame dropped: it arrived %(value)s ms late, past the %(value2)s ms "
+                                                "any input may drive for", value=format(1000 * late_s, ".0f"),
+                                                value2=format(1000 * self.deadman_max_s, ".0f")))
         if self._holder is None:
             self._holder = session
             self._audit("teleop.control_start", session)

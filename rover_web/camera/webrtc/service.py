@@ -298,36 +298,24 @@ class WebRtcService:
             except Closed:
                 raise Unavailable(explain("the server is shutting down"), "shutting_down") from None
             except ShareUsed as exc:
-                raise Unavailable(
-                    explain(
-                        "%(why)s different WebRTC camera streams (ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT); close one first",
-                        why=text_of(exc),
-                    ),
-                    "too_many_producers",
-                ) from None
+                raise Unavailable(explain("%(why)s different WebRTC camera streams "
+                                          "(ROVER_WEB_SUBSCRIPTIONS_PER_CLIENT); close one first", why=text_of(exc)),
+                                  "too_many_producers") from None
             except Full:
-                raise Unavailable(
-                    explain(
-                        "%(count)s different WebRTC camera streams are converted already "
-                        "(ROVER_WEB_CAMERA_MAX_PRODUCERS); view one of them",
-                        count=len(self.producers),
-                    ),
-                    "too_many_producers",
-                ) from None
+                raise Unavailable(explain("%(count)s different WebRTC camera streams are converted already "
+                                          "(ROVER_WEB_CAMERA_MAX_PRODUCERS); view one of them",
+                                          count=len(self.producers)), "too_many_producers") from None
             except Exception as exc:
                 log.exception("cannot subscribe to %s", key.topic)
-                raise CannotSubscribe(
-                    explain("cannot subscribe to %(topic)s: %(why)s", topic=key.topic, why=text_of(exc)),
-                    "cannot_subscribe",
-                ) from None
+                raise CannotSubscribe(explain("cannot subscribe to %(topic)s: %(why)s", topic=key.topic,
+                                              why=text_of(exc)), "cannot_subscribe") from None
             try:
                 answer = self.loop.run(self._negotiate(session, offer), NEGOTIATE_TIMEOUT_S)
             except LoopStopped:
                 raise Unavailable(explain("the server is shutting down"), "shutting_down") from None
             except TimeoutError:
-                raise Unavailable(
-                    explain("the WebRTC loop did not answer the offer in time"), "webrtc_timeout"
-                ) from None
+                raise Unavailable(explain("the WebRTC loop did not answer the offer in time"),
+                                  "webrtc_timeout") from None
         except BaseException:
             self._abandon(session)
             raise
