@@ -12,6 +12,7 @@ import pytest
 from werkzeug.serving import make_server
 
 from rover_web.zenoh_link import signing
+from tests.browser.test_a11y_audit import AXE_URL, SIZES, THEMES, audit
 from tests.conftest import free_port
 
 pytestmark = pytest.mark.browser
@@ -115,6 +116,39 @@ def test_the_hub_page_shows_a_robot_heard_and_the_answers_of_stop_all(hub, stric
     page.locator("#hub-table tr[data-robot='alpha']", has_text="engaged").wait_for(timeout=5000)
     assert page.watch.console_errors == [] and page.watch.offhost == []
     assert page.evaluate("window.__csp") == []
+
+
+def test_the_hub_has_the_display_menu_its_theme_and_language_kept(hub, strict_page):
+    """The fleet's page is read in the sun too: the same Display menu as a robot's pages, kept the same way."""
+    url, _robot = hub
+    page = strict_page
+    page.goto(url + "/robots")
+    page.locator("#hub-table tr[data-robot='alpha']").wait_for(timeout=10000)
+    page.locator("#display-menu > summary").click()
+    page.locator("#display-theme").select_option("daylight")
+    assert page.evaluate("document.documentElement.dataset.theme") == "daylight"
+    assert page.evaluate("getComputedStyle(document.body).backgroundColor") == "rgb(238, 241, 244)"
+    page.locator("#display-language").select_option("es")
+    with page.expect_navigation():
+        page.locator("#display-language").press("Enter")
+    assert page.evaluate("[document.documentElement.lang, document.documentElement.dataset.theme]") == [
+        "es", "daylight"]
+    assert page.locator("#hub-stop-all").inner_text() == "Parar todo"
+    page.locator("#hub-table tr[data-robot='alpha']").wait_for(timeout=10000)
+    # The audit every robot page passes (tests/browser/test_a11y_audit.py), in both themes and sizes.
+    page.add_script_tag(url=url + AXE_URL)
+    found = {}
+    for theme in THEMES:
+        page.locator("#display-menu > summary").click()
+        page.locator("#display-theme").select_option(theme)
+        page.locator("#display-menu > summary").click()
+        for size in SIZES:
+            violations = audit(page, size)
+            if violations:
+                found[f"{theme} {size}"] = violations
+        page.set_viewport_size(SIZES["desktop"])
+    assert found == {}, json.dumps(found, indent=1)
+    assert page.watch.console_errors == [] and page.evaluate("window.__csp") == []
 
 
 def test_the_hub_map_shows_a_robot_where_it_is_links_it_and_dims_it_once_lost(hub, strict_page):
