@@ -59,10 +59,12 @@ fi
 scripts/build_interfaces.sh .venv
 
 if (( want_browser )) && { [[ ! -x /usr/bin/chromium ]] || [[ ! -e /usr/lib/x86_64-linux-gnu/faketime/libfaketimeMT.so.1 ]] \
-                           || [[ ! -x /usr/bin/prometheus ]] || [[ ! -x /usr/bin/promtool ]]; }; then
-  echo "== installing Debian's chromium, faketime and prometheus for the tests"
+                           || [[ ! -x /usr/bin/prometheus ]] || [[ ! -x /usr/bin/promtool ]] \
+                           || [[ ! -e /usr/share/fonts/opentype/ipafont-gothic/ipag.ttf ]]; }; then
+  # fonts-ipafont-gothic: the Japanese pages drawn with real glyphs (3.5 MB), not empty boxes.
+  echo "== installing Debian's chromium, faketime, prometheus and a Japanese font for the tests"
   sudo_cmd=()
   [[ $(id -u) -ne 0 ]] && sudo_cmd=(sudo)
   "${sudo_cmd[@]}" apt-get update -q
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -q chromium faketime prometheus
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -q chromium faketime prometheus fonts-ipafont-gothic
 fi

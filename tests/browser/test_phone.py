@@ -44,8 +44,10 @@ def overflow(page) -> int:
     return page.evaluate("document.documentElement.scrollWidth") - PHONE["width"]
 
 
-def wide_pages(browser, base_url, pages):
+def wide_pages(browser, base_url, pages, language=None):
     context = browser.new_context(viewport=PHONE, is_mobile=True, has_touch=True, bypass_csp=True)
+    if language:
+        context.add_cookies([{"name": "rover_web_lang", "value": language, "url": base_url}])
     try:
         page = context.new_page()
         wide = {}
@@ -64,6 +66,18 @@ def wide_pages(browser, base_url, pages):
 def test_no_page_scrolls_sideways_on_a_phone(live_server, browser, sim_process):
     sim_process()
     assert wide_pages(browser, live_server.url, PAGES) == ""
+
+
+# The pages with the most controls and labels; Spanish's words are the longest of the three languages,
+# Japanese's the widest glyphs (scripts/bootstrap.sh installs a Japanese font, so they are drawn).
+WORDY = ["/", "/status", "/livemap", "/panels", "/waypoints", "/ros", "/recordings", "/tf", "/3d"]
+
+
+@pytest.mark.parametrize("language", ["es", "ja"])
+def test_no_page_scrolls_sideways_on_a_phone_in_spanish_or_japanese(live_server, browser, sim_process, language):
+    sim_process()
+    pages = {path: PAGES.get(path, []) for path in WORDY}
+    assert wide_pages(browser, live_server.url, pages, language) == ""
 
 
 def test_no_fleet_page_scrolls_sideways_on_a_phone(live_server_factory, browser, sim_process):
