@@ -26,7 +26,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from rover_web.web.api_messages import explain
+from rover_web.web.api_messages import Text, explain, said
 from rover_web.web.validate import InvalidInput
 
 if TYPE_CHECKING:
@@ -55,8 +55,13 @@ class Area:
     geometry: Polygon | MultiPolygon
 
     @property
-    def title(self) -> str:
-        return f"{self.kind} area {self.name!r}" if self.name else f"{self.kind} area features[{self.index}]"
+    def title(self) -> Text:
+        # Shown in the breach banner of every viewer: said, in each viewer's language.
+        if self.kind == "keep_in":
+            return (said("keep-in area %(name)s", name=repr(self.name)) if self.name
+                    else said("keep-in area features[%(index)s]", index=self.index))
+        return (said("keep-out area %(name)s", name=repr(self.name)) if self.name
+                else said("keep-out area features[%(index)s]", index=self.index))
 
 
 class Fence:
@@ -92,12 +97,12 @@ class Fence:
         from shapely.geometry import Point
         point = Point(lng, lat)
         if self.keep_in is not None and not self.keep_in.covers(point):
-            return OutsideGeofence(explain("(%(lng)s, %(lat)s) is outside every keep-in area of the geofence",
+            return OutsideGeofence(said("(%(lng)s, %(lat)s) is outside every keep-in area of the geofence",
                                            lng=format(lng, ".7f"), lat=format(lat, ".7f")),
                                    reason="outside_keep_in", lng=lng, lat=lat)
         for area in self.keep_out:
             if area.geometry.intersects(point):
-                return OutsideGeofence(explain("(%(lng)s, %(lat)s) is inside the geofence's %(title)s",
+                return OutsideGeofence(said("(%(lng)s, %(lat)s) is inside the geofence's %(title)s",
                                                lng=format(lng, ".7f"), lat=format(lat, ".7f"), title=area.title),
                                        reason="inside_keep_out", lng=lng, lat=lat, feature=area.index,
                                        name=area.name)

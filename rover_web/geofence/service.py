@@ -8,6 +8,7 @@ import time
 
 from rover_web.estop import EStopService
 from rover_web.panels.oplog import OperatorLog
+from rover_web.web.api_messages import Text, said, text_of, with_wire
 
 from .rules import Fence, OutsideGeofence, parse_fence
 from .store import GeofenceStore
@@ -17,6 +18,11 @@ log = logging.getLogger(__name__)
 CHANNEL = "geofence"
 ESTOP_BY = "geofence breach"
 OPLOG_PANEL = "geofence"  # its entries in the operator log (panel_log)
+
+
+def breach_message(refused: OutsideGeofence) -> Text:
+    """The banner every viewer reads: said, so each browser shows it in its own language."""
+    return said("the robot left the geofence: %(why)s", why=text_of(refused))
 
 
 class GeofenceService:
@@ -104,7 +110,7 @@ class GeofenceService:
             return
         was_outside = self._state["state"] == "outside"
         self._state = {"state": state, "lng": position[0], "lat": position[1], "since": time.time(),
-                       "message": f"the robot left the geofence: {refused}" if refused else None}
+                       "message": breach_message(refused) if refused else None}
         if state == "outside":
             log.warning("geofence breach: %s", refused)
             if self.engage_estop:
@@ -114,8 +120,8 @@ class GeofenceService:
         self._publish()
 
     def state(self) -> dict:
-        return {**self._state, "revision": self.revision, "areas": len(self.fence.areas),
-                "estop_on_breach": self.engage_estop}
+        return with_wire({**self._state, "revision": self.revision, "areas": len(self.fence.areas),
+                          "estop_on_breach": self.engage_estop})
 
     def _publish(self) -> None:
         self.hub.publish(CHANNEL, self.state())

@@ -19,6 +19,7 @@ from flask import Flask, url_for
 from flask_babel import Babel, Domain, get_locale
 
 from rover_web.config import ROOT
+from rover_web.web.api_messages import Text
 
 from .catalogues import SOURCE, Compiled, compile_all
 from .locale import LOCALES, select_locale
@@ -72,6 +73,9 @@ def init_app(app: Flask) -> None:
     _Babel(app, compiled)
     app.extensions.setdefault(GENERATED_STATIC, {}).update(
         {browser_catalogue_name(locale): c.browser for locale, c in compiled.items()})
+
+    # A sentence the server made (api_messages.said or explain) in the page's language: `{{ x|translated }}`.
+    app.jinja_env.filters["translated"] = lambda value: value.translated() if isinstance(value, Text) else value
 
     @app.context_processor
     def _page_language():

@@ -3,8 +3,12 @@
 translations/<lang>/LC_MESSAGES/*.po are the only source. Each start compiles them (in memory, with
 Babel's own .mo writer) so what is served is always what the .po files say: no compiled file is
 committed, and none can be left stale. Every .po domain file of a language is folded into one
-catalogue (the pages' messages.po, and any browser.po or api.po beside it), since the pages, the
-API's messages and the browser code share one set of message ids.
+catalogue (the pages' messages.po, and any browser.po, api.po or events.po beside it), since the
+pages, the API's messages and the browser code share one set of message ids.
+
+The browser's catalogue is the part the browser code uses: entries located in static/js, and every
+entry of events.po, the sentences the server pushes to every viewer (api_messages.said), which each
+browser translates from their id and values.
 """
 
 from __future__ import annotations
@@ -24,6 +28,8 @@ log = logging.getLogger(__name__)
 
 SOURCE = "en"  # the message ids are the English text: no catalogue is needed for it
 BROWSER_SOURCES = "static/js/"  # a `#:` location under here: the browser code uses the entry
+BROWSER_DOMAINS = ("events",)  # every entry of these .po files goes to the browser too
+SAID = "rover-web-said"  # the flag read_language puts on such an entry (never written to a file)
 
 
 @dataclass(frozen=True)
@@ -45,6 +51,8 @@ def read_language(folder: Path, locale: str) -> Catalog:
             if not message.id:
                 continue
             held = merged.get(message.id)
+            if path.stem in BROWSER_DOMAINS:
+                (message if held is None else held).flags.add(SAID)
             if held is None:
                 merged[message.id] = message
             else:
@@ -69,7 +77,7 @@ def browser_catalogue(catalog: Catalog) -> dict:
     for message in catalog:
         if not message.id or not translated(message):
             continue
-        if not any(path.startswith(BROWSER_SOURCES) for path, _line in message.locations):
+        if SAID not in message.flags and not any(path.startswith(BROWSER_SOURCES) for path, _line in message.locations):
             continue
         if isinstance(message.id, tuple | list):
             plurals[message.id[0]] = list(message.string)

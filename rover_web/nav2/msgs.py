@@ -11,15 +11,15 @@ import importlib
 import importlib.util
 
 from rover_web.ros.convert import quaternion_from_yaw, stamp_to_float, yaw_from_quaternion
-from rover_web.web.api_messages import Text, explain
+from rover_web.web.api_messages import Text, said
 
 # kind -> (action name under the robot's namespace, nav2_msgs/action type)
 ACTIONS = {"to_pose": ("navigate_to_pose", "NavigateToPose"),
            "through_poses": ("navigate_through_poses", "NavigateThroughPoses"),
            "follow_waypoints": ("follow_waypoints", "FollowWaypoints")}
-HOW_TO_GET = ("nav2_msgs has no wheel on PyPI: on a robot, source ROS 2 Jazzy with Nav2 "
-              "(/opt/ros/jazzy/setup.bash, package ros-jazzy-nav2-msgs) before starting rover_web; "
-              "elsewhere build it into this Python environment with scripts/build_interfaces.sh")
+HOW_TO_GET = said("nav2_msgs has no wheel on PyPI: on a robot, source ROS 2 Jazzy with Nav2 "
+                  "(/opt/ros/jazzy/setup.bash, package ros-jazzy-nav2-msgs) before starting rover_web; "
+                  "elsewhere build it into this Python environment with scripts/build_interfaces.sh")
 # Nav2 Jazzy's error codes of the servers bt_navigator hands on in its results (their ranges do not
 # overlap); a code nav2_msgs itself names is looked up there first.
 ERROR_NAMES = {
@@ -53,9 +53,9 @@ def missing(load: bool = False) -> Text | None:
         if load:
             importlib.import_module("nav2_msgs.action")
         elif importlib.util.find_spec("nav2_msgs.action") is None:
-            return explain("nav2_msgs is not installed. %(how)s", how=HOW_TO_GET)
+            return said("nav2_msgs is not installed. %(how)s", how=HOW_TO_GET)
     except ImportError as exc:
-        return explain("nav2_msgs could not be imported (%(why)s). %(how)s", why=str(exc), how=HOW_TO_GET)
+        return said("nav2_msgs could not be imported (%(why)s). %(how)s", why=str(exc), how=HOW_TO_GET)
     return None
 
 

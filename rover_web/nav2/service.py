@@ -20,7 +20,7 @@ from typing import Any
 
 from rover_web.core.state import Rover
 from rover_web.estop import EStopService
-from rover_web.web.api_messages import explain, text_of
+from rover_web.web.api_messages import explain, text_of, with_wire
 
 from . import msgs
 
@@ -127,7 +127,8 @@ class Nav2Service:
             lifecycle = [dict(v) for v in self._lifecycle.values()]
         return {
             "available": self.missing is None,
-            "missing": None if self.missing is None else {"packages": ["nav2_msgs"], "message": str(self.missing)},
+            "missing": (None if self.missing is None
+                        else with_wire({"packages": ["nav2_msgs"], "message": self.missing})),
             "goal_mode": self.goal_mode, "goal_via": self.goal_via(),
             "servers": {kind: {"action": name, "ready": bool(client and self.missing is None
                                                              and client.server_ready(name))}

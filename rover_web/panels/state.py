@@ -13,7 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from rover_web.web.api_messages import Text, explain, text_of
+from rover_web.web.api_messages import Text, explain, said, text_of, with_wire
 
 from .scalars import InvalidValue, coerce
 from .spec import ControlSpec, DisplaySpec, PanelSpec
@@ -125,24 +125,23 @@ class PanelState:
         now = self._clock() if now is None else now
         with self._lock:
             if self._estop_engaged() and not control.allowed_during_estop:
-                return Refusal("estop_engaged", explain("the e-stop is engaged: %(label)s is not sent until it is "
-                                                        "released",
-                                                        label=control.label))
+                return Refusal("estop_engaged", said("the e-stop is engaged: %(label)s is not sent until it is "
+                                                     "released", label=control.label))
             if control.requires_unlock and self.locked(now):
-                return Refusal("locked", explain("the %(title)s panel is locked; unlock it first",
-                                                 title=self.spec.title))
+                return Refusal("locked", said("the %(title)s panel is locked; unlock it first",
+                                              title=self.spec.title))
             for display_id, allowed in control.enabled_when:
                 display = self.spec.display(display_id)
                 value, age, fresh = self.reading(display_id, now)
                 wanted = " or ".join(str(v) for v in allowed)
                 if age is None:
-                    return Refusal("not_allowed", explain("%(label)s needs %(display)s to be %(wanted)s; no "
-                                                          "%(display)s has been received yet",
-                                                          label=control.label, display=display.label, wanted=wanted))
+                    return Refusal("not_allowed", said("%(label)s needs %(display)s to be %(wanted)s; no "
+                                                       "%(display)s has been received yet",
+                                                       label=control.label, display=display.label, wanted=wanted))
                 if not fresh:
                     return Refusal(
                         "not_allowed",
-                        explain(
+                        said(
                             "%(label)s needs %(display)s to be %(wanted)s; the last "
                             "%(display)s (%(value)s) is %(age)s s old",
                             label=control.label,
@@ -155,7 +154,7 @@ class PanelState:
                 if not _matches(value, allowed):
                     return Refusal(
                         "not_allowed",
-                        explain(
+                        said(
                             "%(label)s is only allowed when %(display)s is %(wanted)s; it is %(value)s",
                             label=control.label,
                             display=display.label,
@@ -202,7 +201,7 @@ class PanelState:
             controls = {}
             for c in self.spec.controls:
                 refusal = self.refusal(c, now)
-                controls[c.id] = {"enabled": refusal is None, "reason": str(refusal.reason) if refusal else ""}
+                controls[c.id] = with_wire({"enabled": refusal is None, "reason": refusal.reason if refusal else ""})
             return {"locked": self.locked(now), "light": self.light(now), "displays": displays, "controls": controls}
 
     def detail(self, now: float | None = None) -> dict:

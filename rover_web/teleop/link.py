@@ -37,6 +37,8 @@ from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from rover_web.web.api_messages import said, with_wire
+
 STALL_S = 0.2          # the issue's TCP stalls are 0.2-1 s; shorter gaps are jitter
 WINDOW_S = 60.0        # stalls are counted, and the longest reported, over this long
 VERDICT_S = 10.0       # the verdict looks at stalls and losses this recent
@@ -221,7 +223,7 @@ class LinkMeter:
             }
         loss = sum(recent) / (len(recent) + sum(recent)) if len(recent) >= MIN_FRAMES_FOR_LOSS else 0.0
         quality, why = verdict(figures["rtt_ms"], figures["jitter_ms"], recent_stall * 1000, loss)
-        return {**figures, "quality": quality, "why": why}
+        return with_wire({**figures, "quality": quality, "why": why})
 
     def _forget(self, now: float) -> None:
         while self._stalls and self._stalls[0][0] < now - WINDOW_S:
@@ -233,10 +235,10 @@ class LinkMeter:
 def verdict(rtt_ms: float | None, jitter_ms: float | None, stall_ms: float, loss: float) -> tuple[str, str]:
     """(quality, why): the worst band any figure reaches, and the first figure that put it there."""
     figures = (
-        (rtt_ms, "rtt_ms", lambda v: f"{v:.0f} ms round trip"),
-        (jitter_ms, "jitter_ms", lambda v: f"{v:.0f} ms jitter"),
-        (stall_ms, "stall_ms", lambda v: f"a {v:.0f} ms stall"),
-        (loss, "loss", lambda v: f"{100 * v:.0f} % of frames lost"),
+        (rtt_ms, "rtt_ms", lambda v: said("%(ms)d ms round trip", ms=round(v))),
+        (jitter_ms, "jitter_ms", lambda v: said("%(ms)d ms jitter", ms=round(v))),
+        (stall_ms, "stall_ms", lambda v: said("a %(ms)d ms stall", ms=round(v))),
+        (loss, "loss", lambda v: said("%(percent)d %% of frames lost", percent=round(100 * v))),
     )
     for quality, band in (("too_poor", TOO_POOR), ("poor", POOR)):
         for value, name, say in figures:

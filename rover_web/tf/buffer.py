@@ -29,7 +29,7 @@ import threading
 import time
 from bisect import bisect_left
 
-from rover_web.web.api_messages import as_text, explain
+from rover_web.web.api_messages import Text, as_text, explain, said, with_wire
 
 from .transform import NLERP_DOT, Quaternion, Transform, Vector, compose, invert, product
 
@@ -137,7 +137,7 @@ class TfBuffer:
 
     # --- insertion ---
 
-    def _reject(self, reason: str, sentence: str) -> bool:
+    def _reject(self, reason: str, sentence: Text) -> bool:
         self.rejected[reason] = self.rejected.get(reason, 0) + 1
         self.last_rejection[reason] = sentence
         return False
@@ -152,17 +152,20 @@ class TfBuffer:
         stamp_ns = int(stamp_ns)
         with self._lock:
             if not child or not parent:
-                return self._reject("no_frame_id", f"a transform from [{parent}] to [{child}] has an empty frame id")
+                return self._reject("no_frame_id", said("a transform from [%(parent)s] to [%(child)s] has an empty "
+                                                         "frame id", parent=parent, child=child))
             if child == parent:
-                return self._reject("self_transform", f"frame [{child}] given as its own parent")
+                return self._reject("self_transform", said("frame [%(child)s] given as its own parent", child=child))
             if not all(map(math.isfinite, (tx, ty, tz, qx, qy, qz, qw))):
-                return self._reject("nan", f"a transform from [{parent}] to [{child}] holds NaN or infinity")
+                return self._reject("nan", said("a transform from [%(parent)s] to [%(child)s] holds NaN or infinity",
+                                                 parent=parent, child=child))
             norm2 = qx * qx + qy * qy + qz * qz + qw * qw
             frame = self._frames.get(child)
             if frame is None:
                 if len(self._frames) >= MAX_FRAMES:
-                    return self._reject("too_many_frames", f"[{child}] would be frame {MAX_FRAMES + 1}: a publisher "
-                                                           "inventing frame ids must not exhaust memory")
+                    return self._reject("too_many_frames", said("[%(child)s] would be frame %(count)s: a publisher "
+                                                                "inventing frame ids must not exhaust memory",
+                                                                child=child, count=MAX_FRAMES + 1))
                 frame = self._frames[child] = _Frame(child, parent, static)
             frame.received += 1
             frame.last_norm2 = norm2
@@ -171,8 +174,9 @@ class TfBuffer:
             self._parent_names.add(parent)
             if abs(norm2 - 1.0) > QUATERNION_TOLERANCE:
                 frame.unnormalised += 1
-                return self._reject("unnormalised", f"the quaternion of [{child}] (parent [{parent}]) has norm "
-                                                    f"{math.sqrt(norm2):.6f}")
+                return self._reject("unnormalised", said("the quaternion of [%(child)s] (parent [%(parent)s]) has norm "
+                                                         "%(norm)s", child=child, parent=parent,
+                                                         norm=format(math.sqrt(norm2), ".6f")))
             value = ((tx, ty, tz), (qx, qy, qz, qw))
             if not frame.values or frame.parent != parent:
                 self._topology += 1
@@ -191,16 +195,20 @@ class TfBuffer:
             stamps = frame.stamps
             if stamps and stamp_ns >= stamps[-1]:
                 if stamp_ns == stamps[-1]:
-                    return self._reject("repeated", f"repeated stamp {stamp_ns / 1e9:.6f} for [{child}]")
+                    return self._reject("repeated", said("repeated stamp %(stamp)s for [%(child)s]",
+                                                     stamp=format(stamp_ns / 1e9, ".6f"), child=child))
                 stamps.append(stamp_ns)
                 frame.values.append(value)
             else:
                 if stamps and stamp_ns < stamps[-1] - self._cache_ns:
-                    return self._reject("old_data", f"data for [{child}] at {stamp_ns / 1e9:.6f} is older than the "
-                                                    f"cache ({self.cache_s:g} s)")
+                    return self._reject("old_data", said("data for [%(child)s] at %(stamp)s is older than the cache "
+                                                     "(%(cache)s s)", child=child,
+                                                     stamp=format(stamp_ns / 1e9, ".6f"),
+                                                     cache=format(self.cache_s, "g")))
                 i = bisect_left(stamps, stamp_ns)
                 if i < len(stamps) and stamps[i] == stamp_ns:
-                    return self._reject("repeated", f"repeated stamp {stamp_ns / 1e9:.6f} for [{child}]")
+                    return self._reject("repeated", said("repeated stamp %(stamp)s for [%(child)s]",
+                                                     stamp=format(stamp_ns / 1e9, ".6f"), child=child))
                 stamps.insert(i, stamp_ns)
                 frame.values.insert(i, value)
             cut = stamps[-1] - self._cache_ns
@@ -377,23 +385,25 @@ class TfBuffer:
                         "kind": "two_parents", "frame": f.name,
                         "parents": [{"parent": f.parent, "authority": f.authority}]
                         + [{"parent": p, "authority": a} for p, a in others],
-                        "message": f"[{f.name}] is published with more than one parent (the newest wins): "
-                                   + ", ".join(_by(p, a) for p, a in [(f.parent, f.authority), *others])})
+                        "message": said("[%(frame)s] is published with more than one parent (the newest wins): "
+                                        "%(parents)s", frame=f.name, parents=", ".join(
+                                            _by(p, a) for p, a in [(f.parent, f.authority), *others]))})
                 if f.unnormalised and abs(f.last_norm2 - 1.0) > QUATERNION_TOLERANCE:
                     warnings.append({
                         "kind": "unnormalised", "frame": f.name, "norm": math.sqrt(f.last_norm2),
-                        "message": f"[{f.name}]'s quaternion has norm {math.sqrt(f.last_norm2):.6f}: tf2 ignores "
-                                   "such transforms"})
+                        "message": said("[%(frame)s]'s quaternion has norm %(norm)s: tf2 ignores such transforms",
+                                        frame=f.name, norm=format(math.sqrt(f.last_norm2), ".6f"))})
                 if not f.static and age is not None:
                     limit = max(stale_s, 5.0 / rate) if rate else stale_s
                     if age > limit:
                         warnings.append({"kind": "stale", "frame": f.name, "age_s": age,
-                                         "message": f"[{f.name}]'s newest transform is {age:.2f} s old"})
+                                         "message": said("[%(frame)s]'s newest transform is %(age)s s old",
+                                                         frame=f.name, age=format(age, ".2f"))})
                     elif age < -future_s:
                         warnings.append({
                             "kind": "future", "frame": f.name, "ahead_s": -age,
-                            "message": f"[{f.name}] is stamped {-age:.2f} s in the future: the clocks of the "
-                                       "robot and this server disagree"})
+                            "message": said("[%(frame)s] is stamped %(ahead)s s in the future: the clocks of the "
+                                            "robot and this server disagree", frame=f.name, ahead=format(-age, ".2f"))})
             for name in {f.parent for f in frames} - known:
                 rows[name] = {"parent": None, "static": None, "rate_hz": None, "newest_stamp": None,
                               "oldest_stamp": None, "age_s": None, "authority": "", "received": 0,
@@ -401,14 +411,15 @@ class TfBuffer:
             loops = _loops({f.name: f.parent for f in frames})
             for loop in loops:
                 warnings.append({"kind": "loop", "frames": loop,
-                                 "message": "the tree has a loop: " + " → ".join(f"[{x}]" for x in loop + loop[:1])})
+                                 "message": said("the tree has a loop: %(loop)s",
+                                                 loop=" → ".join(f"[{x}]" for x in loop + loop[:1]))})
             in_loop = {x for loop in loops for x in loop}
             roots = sorted(name for name, row in rows.items() if row["parent"] is None)
             if len(roots) > 1:
                 warnings.append({"kind": "several_trees", "roots": roots,
-                                 "message": f"{len(roots)} unconnected trees (roots "
-                                            + ", ".join(f"[{r}]" for r in roots)
-                                            + "): lookups between them fail"})
+                                 "message": said("%(count)d unconnected trees (roots %(roots)s): lookups between "
+                                                 "them fail", count=len(roots),
+                                                 roots=", ".join(f"[{r}]" for r in roots))})
             children: dict[str, list[str]] = {}
             for name, row in rows.items():
                 if row["parent"] is not None:
@@ -416,14 +427,15 @@ class TfBuffer:
             for name, row in rows.items():
                 row["children"] = sorted(children.get(name, ()))
                 row["in_loop"] = name in in_loop
-            rejected = [{"reason": r, "count": c, "message": self.last_rejection.get(r, "")}
+            rejected = [with_wire({"reason": r, "count": c, "message": self.last_rejection.get(r, "")})
                         for r, c in sorted(self.rejected.items())]
+            warnings = [with_wire(w) for w in warnings]
         return {"frames": rows, "roots": roots, "warnings": warnings, "rejected": rejected,
                 "now": now / 1e9, "cache_s": self.cache_s}
 
 
 def _by(parent: str, authority: str) -> str:
-    return f"[{parent}] by {authority}" if authority else f"[{parent}]"
+    return f"[{parent}] ({authority})" if authority else f"[{parent}]"
 
 
 def _loops(parent_of: dict[str, str]) -> list[list[str]]:

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from rover_web.ros import qos
 from rover_web.ros.typesupport import UnknownMessageType, message_class
-from rover_web.web.api_messages import Text, explain, text_of
+from rover_web.web.api_messages import Text, said, text_of
 
 TF_MESSAGE = "tf2_msgs/msg/TFMessage"
-HOW_TO_GET = ("source /opt/ros/jazzy/setup.bash before starting rover_web (a ROS install has tf2_msgs), or "
-              "build it into this Python environment with scripts/build_interfaces.sh")
+HOW_TO_GET = said("source /opt/ros/jazzy/setup.bash before starting rover_web (a ROS install has tf2_msgs), or "
+                  "build it into this Python environment with scripts/build_interfaces.sh")
 
 # tf2_ros's TransformListener: /tf reliable, volatile, keep last 100; /tf_static reliable, transient
 # local, so a late joiner gets every static transform broadcast before it started (each static
@@ -23,7 +23,7 @@ def missing() -> Text | None:
     try:
         message_class(TF_MESSAGE)
     except (UnknownMessageType, ImportError) as exc:
-        return explain(
+        return said(
             "%(type)s is not available (%(why)s): %(how)s", type=TF_MESSAGE, why=text_of(exc), how=HOW_TO_GET
         )
     return None

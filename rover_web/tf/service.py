@@ -16,6 +16,7 @@ import threading
 import time
 
 from rover_web.core.state import Rover
+from rover_web.web.api_messages import with_wire
 
 from . import wire
 from .buffer import TfBuffer
@@ -78,16 +79,16 @@ class TfService:
         with self._lock:
             counts = dict(self.counts)
         publishers = {kind: self._publishers(topic) for kind, topic in self.topics.items()} if self.available else {}
-        return {
+        return with_wire({
             "available": self.available,
-            "missing": None if self.missing is None else str(self.missing),
+            "missing": self.missing,
             "topics": self.topics,
             "publishers": publishers,
             "settings_frames": self.frames,
             "counts": counts,
             "last_undecodable": self.last_undecodable,
             **tree,
-        }
+        })
 
     def publish(self) -> None:
         if self.available:

@@ -15,6 +15,7 @@ import time
 
 from rover_web.core.state import Rover
 from rover_web.placement import MapPlacer, Unplaceable
+from rover_web.web.api_messages import Text, said, with_wire
 
 from . import cloud, poses
 from .markers import BadMarker, Markers3d
@@ -80,12 +81,12 @@ class View3dService:
         self._names: list[str] = []
         self._names_at = 0.0
         self.tf = None  # the tf feature's TfBuffer, set by init_app
-        self.tf_missing: str | None = None  # why TF cannot be heard (no tf2_msgs), or None
+        self.tf_missing: Text | None = None  # why TF cannot be heard (no tf2_msgs), or None
 
-    def _waiting_message(self) -> str:
+    def _waiting_message(self) -> Text:
         if self.urdf_file:
-            return f"reading {self.urdf_file}"
-        return f"waiting for {self.description_topic} (std_msgs/String, transient local)"
+            return said("reading %(file)s", file=self.urdf_file)
+        return said("waiting for %(topic)s (std_msgs/String, transient local)", topic=self.description_topic)
 
     # --- the robot's description ---
 
@@ -116,19 +117,20 @@ class View3dService:
             with self._lock:
                 self._robot_seq += 1
                 self._robot = {"state": "error", "source": self.urdf_file, "seq": self._robot_seq,
-                               "error": {"message": f"cannot read {self.urdf_file}: {exc}", "line": None,
-                                         "column": None}}
+                               "error": with_wire({"message": said("cannot read %(file)s: %(why)s",
+                                                                   file=self.urdf_file, why=str(exc)),
+                                                   "line": None, "column": None})}
             return
         self.on_description(text, self.urdf_file)
 
     def robot(self) -> dict:
         with self._lock:
-            return dict(self._robot, base_frame=self.base_frame, map_frame=self.map_frame,
-                        odom_frame=self.odom_frame, tf=self.tf is not None and not self.tf_missing,
-                        tf_missing=self.tf_missing,
-                        pose_hz=self.pose_hz, cloud_topic=self.cloud_topic or None,
-                        markers_topic=self.markers_topic or None, markers_skipped=dict(self.markers_skipped),
-                        cloud=self.cloud_counts())
+            return with_wire(dict(self._robot, base_frame=self.base_frame, map_frame=self.map_frame,
+                                  odom_frame=self.odom_frame, tf=self.tf is not None and not self.tf_missing,
+                                  tf_missing=self.tf_missing,
+                                  pose_hz=self.pose_hz, cloud_topic=self.cloud_topic or None,
+                                  markers_topic=self.markers_topic or None,
+                                  markers_skipped=dict(self.markers_skipped), cloud=self.cloud_counts()))
 
     # --- poses, once per tick ---
 

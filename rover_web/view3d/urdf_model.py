@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 from lxml import etree
 
-from rover_web.web.api_messages import as_text, explain
+from rover_web.web.api_messages import as_text, said, with_wire
 
 MAX_URDF_BYTES = 8 * 1024 * 1024
 _PLACE = re.compile(r"ParseError in (\S+):\s*(.*)", re.S)
@@ -27,9 +27,9 @@ class UrdfError(Exception):
         self.message, self.line, self.column = self.text.english(), line, column
 
     def as_dict(self) -> dict:
-        # English: the robot's description is parsed once for every viewer, whatever their language.
-        where = f"line {self.line}: " if self.line else ""
-        return {"message": where + self.message, "line": self.line, "column": self.column}
+        # Parsed once for every viewer, whatever their language: said, and translated in each browser.
+        message = said("line %(line)s: %(why)s", line=self.line, why=self.text) if self.line else self.text
+        return with_wire({"message": message, "line": self.line, "column": self.column})
 
 
 @dataclass
@@ -48,7 +48,7 @@ def _tree(text: str):
         return etree.fromstring(text.encode(), parser)
     except etree.XMLSyntaxError as exc:
         line, column = exc.position if exc.position else (None, None)
-        raise UrdfError(explain("not well-formed XML: %(msg)s", msg=exc.msg), line, column) from None
+        raise UrdfError(said("not well-formed XML: %(msg)s", msg=exc.msg), line, column) from None
 
 
 def _line_of(root, place: str) -> int | None:
@@ -66,10 +66,10 @@ def _first(root, xpath: str) -> int | None:
 
 def parse(text: str) -> Model:
     if len(text.encode()) > MAX_URDF_BYTES:
-        raise UrdfError(explain("the description is over %(value)s MiB", value=MAX_URDF_BYTES // (1024 * 1024)))
+        raise UrdfError(said("the description is over %(value)s MiB", value=MAX_URDF_BYTES // (1024 * 1024)))
     root = _tree(text)
     if root.tag != "robot":
-        raise UrdfError(explain("the root element is <%(tag)s>, a URDF's is <robot>", tag=root.tag), root.sourceline)
+        raise UrdfError(said("the root element is <%(tag)s>, a URDF's is <robot>", tag=root.tag), root.sourceline)
     from urdf_parser_py import xml_reflection
     from urdf_parser_py.urdf import URDF
 
@@ -84,24 +84,24 @@ def parse(text: str) -> Model:
         if found:
             place, message = found.group(1), found.group(2).strip()
             line = _line_of(root, re.sub(r"\[@(\w+)\]$", "", place))
-            raise UrdfError(explain("%(message)s (at %(place)s)", message=message, place=place), line) from None
-        raise UrdfError(explain("%(why)s", why=raw or type(exc).__name__)) from None
+            raise UrdfError(said("%(message)s (at %(place)s)", message=message, place=place), line) from None
+        raise UrdfError(said("%(why)s", why=raw or type(exc).__name__)) from None
     links = [link.name for link in robot.links]
     names = set(links)
     if not links:
-        raise UrdfError(explain("the robot has no <link>"), root.sourceline)
+        raise UrdfError(said("the robot has no <link>"), root.sourceline)
     children: dict[str, str] = {}
     joints = []
     for joint in robot.joints:
         where = f"/robot/joint[@name={_quote(joint.name)}]"
         for role, link in (("parent", joint.parent), ("child", joint.child)):
             if link not in names:
-                raise UrdfError(explain("joint %(name)s names %(role)s link %(link)s, which is not a <link>",
+                raise UrdfError(said("joint %(name)s names %(role)s link %(link)s, which is not a <link>",
                                         name=repr(joint.name), role=role, link=repr(link)),
                                 _first(root, where))
         if joint.child in children:
             raise UrdfError(
-                explain(
+                said(
                     "link %(child)s is the child of two joints (%(children)s and %(name)s)",
                     child=repr(joint.child),
                     children=repr(children[joint.child]),
@@ -114,9 +114,9 @@ def parse(text: str) -> Model:
     roots = [name for name in links if name not in children]
     if len(roots) != 1:
         if roots:
-            raise UrdfError(explain("the links form no single tree: %(count)s roots (%(roots)s)",
+            raise UrdfError(said("the links form no single tree: %(count)s roots (%(roots)s)",
                                     count=len(roots), roots=", ".join(roots[:5])))
-        raise UrdfError(explain("the links form no single tree: a loop, and no root"))
+        raise UrdfError(said("the links form no single tree: a loop, and no root"))
     meshes = [m.get("filename", "") for m in root.iter("mesh")]
     return Model(robot.name, roots[0], links, joints, meshes)
 

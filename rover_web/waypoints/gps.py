@@ -14,6 +14,7 @@ from collections import deque
 from dataclasses import dataclass
 
 from rover_web.i18n import N_
+from rover_web.web.api_messages import Text, said, with_wire
 
 EARTH_RADIUS_M = 6371008.8
 STATUS_NO_FIX = -1  # sensor_msgs/NavSatStatus.STATUS_NO_FIX
@@ -42,13 +43,13 @@ def distance_m(lng1: float, lat1: float, lng2: float, lat2: float) -> float:
     return EARTH_RADIUS_M * math.hypot(x, y)
 
 
-def no_fix_reason(reading: FixReading) -> str | None:
+def no_fix_reason(reading: FixReading) -> Text | None:
     if reading.status < 0:
-        return N_("no satellite lock")
+        return said("no satellite lock")
     if not (math.isfinite(reading.lat) and math.isfinite(reading.lng)):
-        return N_("position is not a finite number")
+        return said("position is not a finite number")
     if not (-90.0 <= reading.lat <= 90.0 and -180.0 <= reading.lng <= 180.0):
-        return N_("position is outside the valid latitude/longitude range")
+        return said("position is outside the valid latitude/longitude range")
     return None
 
 
@@ -74,7 +75,7 @@ class GpsTrack:
                 if not self._track or distance_m(*self._track[-1], *point) >= self.min_step_m:
                     self._track.append(point)
             fix = reason is None
-            self._state = {
+            self._state = with_wire({
                 "fix": fix,
                 "reason": reason,
                 "status": reading.status,
@@ -85,7 +86,7 @@ class GpsTrack:
                 "alt": _finite_or_none(reading.alt, 2) if fix else None,
                 "accuracy_m": _finite_or_none(reading.horizontal_sigma_m, 2) if fix else None,
                 "track": [list(p) for p in self._track],
-            }
+            })
             return self._state
 
     def state(self) -> dict | None:

@@ -60,6 +60,14 @@ class Text(str):
             log.warning("the translation of %r does not fit its values; answering in English", self.msgid)
             return _fill(self.msgid, self.values, render)
 
+    def wire(self) -> dict:
+        """The form a browser translates: {"id": msgid, "values": {...}}, a Text value in its own wire form.
+
+        Sent beside the English as `<field>_i18n` (with_wire), for a sentence pushed to every viewer
+        whatever their language; static/js/core/i18n.js's `said` reads it."""
+        values = {name: value.wire() if isinstance(value, Text) else value for name, value in self.values.items()}
+        return {"id": self.msgid, "values": values} if values else {"id": self.msgid}
+
     def __repr__(self) -> str:
         return f"Text({self.msgid!r}, {self.values!r})"
 
@@ -73,6 +81,25 @@ def explain(msgid: str, **values: Any) -> Text:
     `explain` is an extraction keyword: the msgid must be a literal.
     """
     return Text(msgid, values)
+
+
+def said(msgid: str, **values: Any) -> Text:
+    """A sentence pushed to every viewer (an SSE channel, a state answer), translated in each browser.
+
+    The same Text as explain(), under another extraction keyword: `said` messages go to events.po
+    (translations/events_babel.cfg), the catalogue the browser code also receives, so a page in
+    Spanish says it in Spanish from the `<field>_i18n` beside the English (with_wire). A Text that is
+    a value of a said message is shown in the browser too: write it with `said` as well.
+    """
+    return Text(msgid, values)
+
+
+def with_wire(payload: dict) -> dict:
+    """`payload` with `<key>_i18n` beside each value that is a Text: the English stays where it was."""
+    for key, value in list(payload.items()):
+        if isinstance(value, Text):
+            payload[f"{key}_i18n"] = value.wire()
+    return payload
 
 
 def text_of(exc: BaseException) -> Text:

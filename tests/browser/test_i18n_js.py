@@ -11,6 +11,7 @@ catalogue's words, and a catalogue that cannot be loaded leaves the page working
 
 from __future__ import annotations
 
+import json
 import threading
 import time
 from functools import partial
@@ -20,7 +21,11 @@ from pathlib import Path
 import pytest
 
 from rover_web.config import ROOT
+from rover_web.geofence.rules import parse_fence
+from rover_web.geofence.service import breach_message
 from rover_web.i18n.catalogues import compile_language
+from rover_web.teleop.link import verdict
+from rover_web.web.api_messages import Text, with_wire
 
 pytestmark = pytest.mark.browser
 
@@ -170,6 +175,43 @@ def test_a_japanese_page_has_one_plural_form(page, server):
                 ngettext('%(num)d pose', '%(num)d poses', 5), _('Pause')];
     }""")
     assert got == ["作動中", "姿勢 1 個", "姿勢 5 個", "一時停止"]
+
+
+def said_payloads() -> dict:
+    """Sentences as the server pushes them to every viewer, made by the real code and sent as JSON."""
+    fence = parse_fence({"type": "FeatureCollection", "features": [{
+        "type": "Feature", "properties": {"kind": "keep_out", "name": "dock"},
+        "geometry": {"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]]}}]}, 1000)
+    breach = with_wire({"state": "outside", "message": breach_message(fence.refusal(0.5, 0.5))})
+    quality, why = verdict(12345.0, None, 0.0, 0.0)
+    link = with_wire({"quality": quality, "why": why})
+    return json.loads(json.dumps({"breach": breach, "link": link, "plain": {"message": "a robot's own words"},
+                                  "unknown": with_wire({"message": Text("not in any catalogue %(x)s", {"x": 1})})}))
+
+
+@pytest.mark.parametrize("lang,breach,link", [
+    ("en", "the robot left the geofence: (0.5000000, 0.5000000) is inside the geofence's keep-out area 'dock'",
+     "12,345 ms round trip"),
+    ("es", "el robot salió de la geovalla: (0.5000000, 0.5000000) está dentro de zona prohibida 'dock' de la geovalla",
+     "12.345 ms de ida y vuelta"),
+    ("ja", "ロボットがジオフェンスの外に出ました: "
+     "(0.5000000, 0.5000000) はジオフェンスの 禁止エリア 'dock' の内側にあります",
+     "往復 12,345 ms"),
+])
+def test_what_the_server_said_is_shown_in_the_pages_language(page, server, lang, breach, link):
+    """A sentence made once for every viewer (api_messages.said) carries its id and values beside its English;
+    each page translates it, a sentence within it too, with its numbers in the page's locale."""
+    open_page(page, server, lang)
+    payloads = said_payloads()
+    got = page.evaluate("""(p) => {
+        const { said } = window.i18n;
+        return [said(p.breach, 'message'), said(p.link, 'why'), said(p.plain, 'message'), said(p.unknown, 'message'),
+                said(null, 'message'), said({}, 'message')];
+    }""", payloads)
+    assert got == [breach, link, "a robot's own words", "not in any catalogue 1", "", ""]
+    # The English beside the wire form is what an English page, curl and the logs read.
+    english = payloads["breach"]["message"]
+    assert (english == got[0]) == (lang == "en")
 
 
 def test_a_catalogue_that_cannot_be_loaded_leaves_the_page_working_in_english(page, server):

@@ -93,6 +93,26 @@ export function _(msgid, values) {
 
 export const gettext = _;
 
+// A sentence the server made once for every viewer (rover_web/web/api_messages.py `said`): its English
+// at source[key], its id and values at source[key + '_i18n'], translated here from events.po's entries
+// in this page's catalogue. A value that is itself a sentence ({id, values}) is translated too. No
+// wire form (an older server, a robot's own text): the English, as sent.
+function fromWire(wire) {
+  const values = {};
+  for (const [name, value] of Object.entries(wire.values || {})) {
+    values[name] = isWire(value) ? fromWire(value) : value;
+  }
+  return _(wire.id, values);
+}
+function isWire(value) {
+  return Boolean(value) && typeof value === 'object' && typeof value.id === 'string';
+}
+export function said(source, key) {
+  if (!source) return '';
+  const wire = source[`${key}_i18n`];
+  return isWire(wire) ? fromWire(wire) : (source[key] ?? '');
+}
+
 // gettext's plural forms from Intl's categories. Babel writes a language's forms in CLDR's order of
 // categories (zero, one, two, few, many, other: Spanish's three are one, many for a round million, and
 // other; English's two are one and other; Japanese has other alone), and Intl knows the same

@@ -2,7 +2,7 @@
 // as an arrow on the dot, its horizontal accuracy as a circle (one standard deviation, from
 // NavSatFix.position_covariance), and its recent track. Channels: `fix` and `heading`.
 import { fmtLatLng } from './gps_map.js';
-import { _, formatUnit } from '../core/i18n.js';
+import { _, formatUnit, said } from '../core/i18n.js';
 
 const EMPTY = { type: 'FeatureCollection', features: [] };
 const EARTH_RADIUS_M = 6371008.8;
@@ -94,7 +94,7 @@ export function createRobot(out, quality) {
     } else {
       delete out.dataset.lng;
       delete out.dataset.lat;
-      out.textContent = _('no fix (%(reason)s)', { reason: fix.reason });
+      out.textContent = _('no fix (%(reason)s)', { reason: said(fix, 'reason') });
     }
     const q = fix.fix ? fix.quality || 'fix' : 'none';
     quality.dataset.quality = q;

@@ -5,7 +5,7 @@
 // mirrors what is shown, for the browser tests.
 import { api, ApiError } from '../core/api.js';
 import { on } from '../live/live.js';
-import { _, ngettext, formatNumber, formatUnit } from '../core/i18n.js';
+import { _, ngettext, formatNumber, formatUnit, said } from '../core/i18n.js';
 
 const $ = (id) => document.getElementById(id);
 const fmt = (v, digits = 1) => (Number.isFinite(v) ? formatNumber(v, digits) : '—');
@@ -40,7 +40,7 @@ export function attachNav2(S, { redraw, say }) {
     panel.dataset.available = n.available ? 'yes' : 'no';
     const missing = $('nav2-missing');
     missing.hidden = !n.missing;
-    if (n.missing) missing.textContent = _("Nav2's actions are off: %(reason)s", { reason: n.missing.message });
+    if (n.missing) missing.textContent = _("Nav2's actions are off: %(reason)s", { reason: said(n.missing, 'message') });
     $('nav2-via').textContent = n.goal_via === 'action'
       ? _('Goals go to %(action)s (NavigateToPose).', { action: n.servers.to_pose.action })
       : n.available ? _('Goals go to the goal topic (no NavigateToPose server answers yet).') : _('Goals go to the goal topic.');

@@ -3,7 +3,7 @@
 // allowed; the page only mirrors it so an operator sees why a button is disabled.
 import { api, ApiError } from '../core/api.js';
 import { on } from '../live/live.js';
-import { _ } from '../core/i18n.js';
+import { _, said } from '../core/i18n.js';
 
 const LIGHT_TEXT = { green: _('not running'), red: _('running'), unknown: _('unknown') };
 
@@ -53,7 +53,7 @@ function showView(root, view) {
     const control = view.controls[button.dataset.control];
     if (!control) continue;
     button.dataset.allowed = control.enabled ? 'yes' : 'no';
-    button.title = control.reason;
+    button.title = said(control, 'reason');
     refreshButton(root, button);
   }
 }

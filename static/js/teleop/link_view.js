@@ -3,7 +3,7 @@
 // judges the link too poor to drive. The figures and the verdict are the server's
 // (rover_web/teleop/link.py): the page only shows them.
 
-import { _, formatNumber, formatUnit } from '../core/i18n.js';
+import { _, formatNumber, formatUnit, said } from '../core/i18n.js';
 
 const ms = (v) => (v === null || v === undefined ? '—' : formatUnit(Math.round(v), 'ms'));
 
@@ -27,7 +27,7 @@ export function linkView(root = document) {
     set('teleop-quality', QUALITY[link.quality] || link.quality);
     if (banner) {
       banner.hidden = link.quality !== 'too_poor';
-      banner.textContent = link.quality === 'too_poor' ? _('Link too poor to drive safely: %(why)s', { why: link.why }) : '';
+      banner.textContent = link.quality === 'too_poor' ? _('Link too poor to drive safely: %(why)s', { why: said(link, 'why') }) : '';
     }
   }
 

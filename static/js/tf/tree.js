@@ -2,7 +2,7 @@
 // tree in the replay view): each frame a box under its parent as view_frames draws it, the edge
 // labelled static or its rate and age, the warnings, and the picked frame's details. Pure DOM.
 
-import { _, ngettext, formatNumber, formatUnit } from '../core/i18n.js';
+import { _, ngettext, formatNumber, formatUnit, said } from '../core/i18n.js';
 
 // A ROS stamp: seconds since 1970, never grouped in thousands.
 const STAMP = { minimumFractionDigits: 3, maximumFractionDigits: 3, useGrouping: false };
@@ -88,7 +88,7 @@ export function showTree(tree, where, state) {
   where.warnings.replaceChildren(...tree.warnings.map((w) => {
     const li = document.createElement('li');
     li.dataset.kind = w.kind;
-    li.textContent = w.message;
+    li.textContent = said(w, 'message');
     return li;
   }));
   const seen = new Set();

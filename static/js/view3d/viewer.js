@@ -12,7 +12,7 @@ import { Overlays } from './overlays.js';
 import { Poses } from './poses.js';
 import { RobotModel } from './robot.js';
 import { TfAxes } from './tf_axes.js';
-import { _, ngettext } from '../core/i18n.js';
+import { _, ngettext, said } from '../core/i18n.js';
 
 export function webglMissing() {
   try {
@@ -99,8 +99,8 @@ export class Viewer {
     this.poses.aliases = { map: description.map_frame || 'map', odom: description.odom_frame || 'odom' };
     this.overlays.mapFrame = description.map_frame || 'map';
     this.updateCloud();  // the cloud needs only its topic, not a good model
-    if (description.state === 'waiting') { this.status(description.message, 'waiting'); return; }
-    if (description.state === 'error') { this.status(_('URDF refused: %(reason)s', { reason: description.error.message }), 'error'); return; }
+    if (description.state === 'waiting') { this.status(said(description, 'message'), 'waiting'); return; }
+    if (description.state === 'error') { this.status(_('URDF refused: %(reason)s', { reason: said(description.error, 'message') }), 'error'); return; }
     await this.layers.robot.build(description);
     this.container.dataset.robot = description.name;
     this.container.dataset.links = String(this.layers.robot.links.size);

@@ -74,7 +74,11 @@ def test_a_cloud_is_thinned_to_the_bound_with_its_extent_kept(live_server_factor
     # nothing newer: 204 after the wait, with the sequence the page has
     again = requests.get(server.url + "/api/3d/cloud", params={"after": seq, "wait": 0.3}, timeout=5)
     assert again.status_code in (200, 204)
-    assert wait_until(lambda: robot(server)["cloud"]["skipped"].get("no_xyz"), 30, "the bad cloud counted")
+
+    def bad_counted():
+        peer.publish("/points", bad)  # best effort, as a lidar's: a loaded machine may lose one
+        return robot(server)["cloud"]["skipped"].get("no_xyz")
+    assert wait_until(bad_counted, 30, "the bad cloud counted", interval=0.3)
 
 
 def test_a_waiting_cloud_request_holds_a_stream_slot(live_server_factory):

@@ -102,7 +102,8 @@ def write_po(path, lang, entries):
 
 def test_the_browser_catalogue_holds_the_browser_codes_translated_entries(tmp_path):
     """Built from every .po of the language (messages.po and a browser.po beside it, as before and after
-    the merge), only entries located in static/js, and never a fuzzy or untranslated one."""
+    the merge): entries located in static/js and every entry of events.po, never a fuzzy or untranslated
+    one, nor an API error's (the server translates those itself)."""
     folder = tmp_path / "es"
     write_po(folder / "LC_MESSAGES" / "messages.po", "es", [
         '#: templates/base.html:3\nmsgid "Sign out"\nmsgstr "Cerrar sesión"\n',
@@ -115,12 +116,20 @@ def test_the_browser_catalogue_holds_the_browser_codes_translated_entries(tmp_pa
         '#: static/js/teleop/stick.js:14\n#, fuzzy\nmsgid "Go"\nmsgstr "Ir"\n',
         '#: static/js/teleop/stick.js:15\nmsgid "Later"\nmsgstr ""\n',
     ])
+    # What the server says to every viewer (api_messages.said): located in Python, sent all the same.
+    write_po(folder / "LC_MESSAGES" / "events.po", "es", [
+        '#: rover_web/teleop/link.py:9\nmsgid "%(ms)d ms jitter"\nmsgstr "%(ms)d ms de fluctuación"\n',
+        '#: rover_web/teleop/link.py:10\n#, fuzzy\nmsgid "a stall"\nmsgstr "un bloqueo"\n',
+    ])
+    write_po(folder / "LC_MESSAGES" / "api.po", "es", [
+        '#: rover_web/web/http.py:9\nmsgid "no such route"\nmsgstr "no existe la ruta"\n',
+    ])
     compiled = compile_language(folder, "es")
     import json
 
     assert json.loads(compiled.browser) == {
         "locale": "es",
-        "messages": {"Robot": "Robot (es)", "Stop": "Detener"},
+        "messages": {"Robot": "Robot (es)", "Stop": "Detener", "%(ms)d ms jitter": "%(ms)d ms de fluctuación"},
         "plurals": {"%(num)d robot": ["%(num)d robot", "%(num)d de robots", "%(num)d robots"]},
     }
     # The pages' translations come from the same files; fuzzy and untranslated stay English.
@@ -128,6 +137,8 @@ def test_the_browser_catalogue_holds_the_browser_codes_translated_entries(tmp_pa
     assert (t.gettext("Sign out"), t.gettext("Stop"), t.gettext("Go"), t.gettext("Later")) == \
         ("Cerrar sesión", "Detener", "Go", "Later")
     assert t.ngettext("%(num)d robot", "%(num)d robots", 2) == "%(num)d robots"
+    assert t.gettext("no such route") == "no existe la ruta"
+    assert t.gettext("%(ms)d ms jitter") == "%(ms)d ms de fluctuación"
 
 
 @pytest.fixture

@@ -20,12 +20,16 @@ MESSAGE_ARG = {
     "explain": 0,
 }
 KEYWORDS = [f"{name}:{index + 1}" for name, index in MESSAGE_ARG.items()]
+# A sentence pushed to every viewer: extracted on its own into events.pot (translations/events_babel.cfg).
+SAID_ARG = {"said": 0}
+EVENT_KEYWORDS = [f"{name}:{index + 1}" for name, index in SAID_ARG.items()]
+LITERAL_ARG = {**MESSAGE_ARG, **SAID_ARG}
 
 # A message that is not a literal may only be a Text carried from where it was written and extracted.
-CARRIERS = {"text_of", "explain", "_http_text"}
+CARRIERS = {"text_of", "explain", "said", "_http_text"}
 
 # Exceptions whose message reaches a user as an API error's `message` (or a teleop frame's): their
-# message argument (0-based index) must be an explain(...) Text, so it is extracted and translated.
+# message argument (0-based index) must be an explain(...) or said(...) Text, so it is extracted and translated.
 REFUSALS = {
     "AccountError": 0, "AdminRefused": 2, "AmbiguousType": 0, "BadFeatures": 0, "CannotSubscribe": 0,
     "CommandRefused": 0, "EchoRefused": 0, "FieldError": 1, "FrameError": 1, "GoalRejected": 0, "HashingBusy": 0,
@@ -87,16 +91,16 @@ def problems(root: Path = PACKAGE) -> list[str]:
                 if not _carried(arg):
                     found.append(f"{where}: message is {type(arg).__name__}, not explain(\"...\") or a carried Text")
                 continue
-            if name not in MESSAGE_ARG:
+            if name not in LITERAL_ARG:
                 continue
-            index = MESSAGE_ARG[name]
+            index = LITERAL_ARG[name]
             if any(isinstance(a, ast.Starred) for a in node.args[:index + 1]):
                 found.append(f"{where}: *args hide the message")
                 continue
             if len(node.args) <= index:
                 if name in ("ApiError", "InvalidInput") and any(k.arg == "message" for k in node.keywords):
                     found.append(f"{where}: message given by keyword; pass it positionally")
-                elif name not in ("ApiError", "error_response", "InvalidInput", "explain"):
+                elif name not in ("ApiError", "error_response", "InvalidInput", "explain", "said"):
                     continue
                 else:
                     found.append(f"{where}: no message")
@@ -104,7 +108,7 @@ def problems(root: Path = PACKAGE) -> list[str]:
             arg = node.args[index]
             if isinstance(arg, ast.Constant) and isinstance(arg.value, str):
                 continue
-            if name != "explain" and _carried(arg):
+            if name not in ("explain", "said") and _carried(arg):
                 continue
             kind = "an f-string" if isinstance(arg, ast.JoinedStr) else type(arg).__name__
             found.append(f"{where}: message is {kind}, not a literal msgid")

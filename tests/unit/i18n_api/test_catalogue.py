@@ -1,8 +1,10 @@
-"""The API's messages are all extractable, and every one is translated in each shipped language.
+"""The API's messages and the sentences pushed to every viewer are all extractable, and every one is
+translated in each shipped language.
 
 The extraction is the real `pybabel extract` over rover_web/ with the keywords of message_sites.py
-(the ones translations/api_babel.cfg and docs/i18n_api.md give), so a message written so that Babel
-cannot see it, or seen but missing from a catalogue, fails here before it ships.
+(the ones translations/api_babel.cfg, translations/events_babel.cfg and docs/i18n_api.md give), so a
+message written so that Babel cannot see it, or seen but missing from a catalogue, fails here before
+it ships. Each domain (api, events) is checked alike.
 """
 
 from __future__ import annotations
@@ -15,19 +17,22 @@ from pathlib import Path
 import pytest
 from babel.messages.pofile import read_po
 
-from tests.unit.i18n_api.message_sites import KEYWORDS, ROOT, problems
+from tests.unit.i18n_api.message_sites import EVENT_KEYWORDS, KEYWORDS, ROOT, problems
 
 LANGUAGES = ("es", "ja")
 PLACEHOLDER = re.compile(r"%\((\w+)\)[sd]")
 FIELD = re.compile(r"'\w+'|\w+\[\]")  # 'value', features[] once the placeholders are gone
 
 
-@pytest.fixture(scope="module")
-def extracted(tmp_path_factory) -> dict[str, object]:
-    pot = tmp_path_factory.mktemp("pot") / "api.pot"
+DOMAINS = {"api": ("api_babel.cfg", KEYWORDS), "events": ("events_babel.cfg", EVENT_KEYWORDS)}
+
+
+def extract(domain: str, folder: Path) -> dict[str, object]:
+    config, keywords = DOMAINS[domain]
+    pot = folder / f"{domain}.pot"
     pybabel = Path(sys.executable).with_name("pybabel")
-    command = [str(pybabel), "extract", "-F", str(ROOT / "translations" / "api_babel.cfg"), "--no-default-keywords",
-               *[arg for keyword in KEYWORDS for arg in ("-k", keyword)], "-o", str(pot), str(ROOT)]
+    command = [str(pybabel), "extract", "-F", str(ROOT / "translations" / config), "--no-default-keywords",
+               *[arg for keyword in keywords for arg in ("-k", keyword)], "-o", str(pot), str(ROOT)]
     done = subprocess.run(command, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     # Babel skips an f-string at a keyword's call without failing; such a message is never translated.
@@ -37,8 +42,18 @@ def extracted(tmp_path_factory) -> dict[str, object]:
         return {m.id: m for m in read_po(f) if m.id}
 
 
-def _catalogue(lang: str):
-    with (ROOT / "translations" / lang / "LC_MESSAGES" / "api.po").open("rb") as f:
+@pytest.fixture(scope="module")
+def extractions(tmp_path_factory) -> dict[str, dict]:
+    return {domain: extract(domain, tmp_path_factory.mktemp(domain)) for domain in DOMAINS}
+
+
+@pytest.fixture(scope="module")
+def extracted(extractions) -> dict[str, object]:
+    return extractions["api"]
+
+
+def _catalogue(lang: str, domain: str = "api"):
+    with (ROOT / "translations" / lang / "LC_MESSAGES" / f"{domain}.po").open("rb") as f:
         return read_po(f, locale=lang)
 
 
@@ -54,37 +69,53 @@ def test_the_extraction_finds_the_api_messages(extracted):
     assert "the e-stop is engaged: nobody takes control until it is released" in extracted  # explain()
 
 
-def test_the_committed_template_is_the_extraction(extracted):
-    with (ROOT / "translations" / "api.pot").open("rb") as f:
+def test_the_extraction_finds_the_sentences_said_to_every_viewer(extractions):
+    said = extractions["events"]
+    assert len(said) > 40
+    assert "the robot left the geofence: %(why)s" in said  # geofence/service.py
+    assert "%(ms)d ms round trip" in said  # teleop/link.py
+    # One file each: a sentence said to every viewer is in events.po alone (a msgid of nothing but a
+    # placeholder, "%(why)s", may be in both: it has nothing to translate).
+    both = set(said) & set(extractions["api"])
+    assert {msgid for msgid in both if PLACEHOLDER.sub("", msgid).strip()} == set()
+
+
+@pytest.mark.parametrize("domain", DOMAINS)
+def test_the_committed_template_is_the_extraction(extractions, domain):
+    with (ROOT / "translations" / f"{domain}.pot").open("rb") as f:
         committed = {m.id for m in read_po(f) if m.id}
-    assert committed == set(extracted), "run the extraction again (docs/i18n_api.md)"
+    assert committed == set(extractions[domain]), "run the extraction again (docs/i18n_api.md)"
 
 
+@pytest.mark.parametrize("domain", DOMAINS)
 @pytest.mark.parametrize("lang", LANGUAGES)
-def test_every_message_is_translated_and_none_is_fuzzy(extracted, lang):
-    catalogue = _catalogue(lang)
-    missing = [msgid for msgid in extracted if catalogue.get(msgid) is None or not catalogue.get(msgid).string]
+def test_every_message_is_translated_and_none_is_fuzzy(extractions, lang, domain):
+    catalogue = _catalogue(lang, domain)
+    missing = [msgid for msgid in extractions[domain]
+               if catalogue.get(msgid) is None or not catalogue.get(msgid).string]
     fuzzy = [m.id for m in catalogue if m.id and m.fuzzy]
     assert missing == []
     assert fuzzy == []
 
 
+@pytest.mark.parametrize("domain", DOMAINS)
 @pytest.mark.parametrize("lang", LANGUAGES)
-def test_a_translation_has_the_same_placeholders_as_its_msgid(extracted, lang):
+def test_a_translation_has_the_same_placeholders_as_its_msgid(lang, domain):
     wrong = []
-    for m in _catalogue(lang):
+    for m in _catalogue(lang, domain):
         if m.id and m.string and set(PLACEHOLDER.findall(m.string)) != set(PLACEHOLDER.findall(m.id)):
             wrong.append((m.id, m.string))
     assert wrong == []
 
 
+@pytest.mark.parametrize("domain", DOMAINS)
 @pytest.mark.parametrize("lang", LANGUAGES)
-def test_no_translation_is_left_in_english(extracted, lang):
+def test_no_translation_is_left_in_english(lang, domain):
     # A msgstr copied from its msgid would pass the checks above and still show English; only
     # messages that are nothing but values and field names (e.g. "features[%(i)s]: %(why)s") may
     # stay as they are.
     def words(msgid: str) -> str:
         return FIELD.sub("", PLACEHOLDER.sub("", msgid)).strip(" :;.()[]")
 
-    same = [m.id for m in _catalogue(lang) if m.id and m.string == m.id and words(m.id)]
+    same = [m.id for m in _catalogue(lang, domain) if m.id and m.string == m.id and words(m.id)]
     assert same == []

@@ -169,7 +169,8 @@ def test_the_e_stop_refuses_every_control_but_the_allowed_ones_and_the_page_says
     for cid in ("takeoff", "destination", "return", "height"):
         refusal = state.refusal(control(state, cid))
         assert refusal.code == "estop_engaged" and "e-stop" in refusal.reason
-        assert state.view()["controls"][cid] == {"enabled": False, "reason": refusal.reason}
+        assert state.view()["controls"][cid] == {"enabled": False, "reason": refusal.reason,
+                                                 "reason_i18n": refusal.reason.wire()}
     assert state.refusal(control(state, "stop")) is None  # allowed_during_estop
     assert state.view()["controls"]["stop"]["enabled"] is True
     assert panel.on_estop == "stop"
