@@ -8,7 +8,10 @@ from .history import EVENTS
 HEARD_ROBOT = {**ROBOT, "properties": {
     **ROBOT["properties"],
     "url": {"type": ["string", "null"], "description": "the robot's own rover_web (its ROVER_WEB_PUBLIC_URL)"},
-    "alerts": {"type": "array", "items": {"type": "string"}},
+    "alerts": {"type": "array", "items": {"type": "string"}, "description": "in English"},
+    "alerts_i18n": {"type": "array", "items": {"type": "object"},
+                    "description": "each alert's message id and values, for a page in another language "
+                                   "(docs/api.md)"},
     "heard": {"type": "string", "enum": ["waiting", "live", "lost"],
               "description": "live: its liveliness token is there and a summary came within "
                              "ROVER_WEB_FLEET_LOST_AFTER_S; waiting: its token came and no summary since (for "

@@ -19,7 +19,7 @@ from flask import Flask, url_for
 from flask_babel import Babel, Domain, get_locale
 
 from rover_web.config import ROOT
-from rover_web.web.api_messages import Text
+from rover_web.web.api_messages import Text, from_wire
 
 from .catalogues import SOURCE, Compiled, compile_all
 from .locale import LOCALES, select_locale
@@ -76,6 +76,8 @@ def init_app(app: Flask) -> None:
 
     # A sentence the server made (api_messages.said or explain) in the page's language: `{{ x|translated }}`.
     app.jinja_env.filters["translated"] = lambda value: value.translated() if isinstance(value, Text) else value
+    # One received from elsewhere in its wire form (a robot's alerts on the hub): `{{ english|from_wire(wire) }}`.
+    app.jinja_env.filters["from_wire"] = lambda english, wire: from_wire(wire, english) if wire else english
 
     @app.context_processor
     def _page_language():

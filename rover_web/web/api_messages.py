@@ -102,6 +102,36 @@ def with_wire(payload: dict) -> dict:
     return payload
 
 
+WIRE_DEPTH = 4  # a sentence within a sentence within...: deeper than the code ever says is not one
+
+
+def from_wire(wire: Any, english: str) -> str:
+    """A sentence received in its wire form (a robot's summary, read on the hub), in the request's language.
+
+    The form came from elsewhere: anything that is not one (a bad id, values that do not fill it,
+    too deep) gives the English that was sent beside it, never an error."""
+    try:
+        return _text_from_wire(wire, 0).translated()
+    except (KeyError, ValueError, TypeError):
+        return english
+
+
+def _text_from_wire(wire: Any, depth: int) -> Text:
+    if depth > WIRE_DEPTH or not isinstance(wire, dict) or not isinstance(wire.get("id"), str):
+        raise ValueError("not a sentence")
+    raw = wire.get("values", {})
+    if not isinstance(raw, dict):
+        raise ValueError("values are not an object")
+    values = {}
+    for name, value in raw.items():
+        if isinstance(value, dict):
+            value = _text_from_wire(value, depth + 1)
+        elif value is not None and not isinstance(value, str | int | float | bool):
+            raise ValueError("a value is neither text nor a number")
+        values[str(name)] = value
+    return Text(wire["id"], values)
+
+
 def text_of(exc: BaseException) -> Text:
     """The Text an exception was raised with (its `text`, or an `explain(...)` argument).
 

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 
 from rover_web.estop import EStopService
 from rover_web.fleet.summary import summary as fleet_summary
+from rover_web.web.api_messages import Text, said
 
 from . import signing
 from .session import LinkSettings, alive_key, open_session, stop_key, summary_key
@@ -41,13 +42,18 @@ def robot_summary(rover: Rover, public_url: str | None) -> dict:
     """The robot's line of GET /api/robots, its URL made absolute for the hub, and its alerts."""
     line = fleet_summary(rover, "")
     line["url"] = f"{public_url.rstrip('/')}{line['url']}" if public_url else None
-    alerts = []
-    if line["link"] in ("stale", "degraded"):
-        alerts.append(f"link {line['link']}")
+    alerts: list[Text] = []
+    if line["link"] == "stale":
+        alerts.append(said("link stale"))
+    elif line["link"] == "degraded":
+        alerts.append(said("link degraded"))
     geofence = rover.hub.latest("geofence") or {}
     if geofence.get("state") == "outside":
-        alerts.append(geofence.get("message") or "outside the geofence")
-    line["alerts"] = alerts
+        message = geofence.get("message")
+        alerts.append(message if isinstance(message, Text) else said("outside the geofence"))
+    # The English for any reader, and each one's id and values for the hub's page in its language.
+    line["alerts"] = [a.english() for a in alerts]
+    line["alerts_i18n"] = [a.wire() for a in alerts]
     return line
 
 

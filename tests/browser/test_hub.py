@@ -14,6 +14,7 @@ from werkzeug.serving import make_server
 from rover_web.zenoh_link import signing
 from tests.browser.test_a11y_audit import AXE_URL, SIZES, THEMES, audit
 from tests.conftest import free_port
+from tests.unit.zenoh_link.test_alerts import breach_alerts
 
 pytestmark = pytest.mark.browser
 
@@ -38,6 +39,7 @@ class LightRobot:
         self.endpoint = endpoint
         self.engaged = False
         self.position = None
+        self.alerts: tuple[list, list] = ([], [])  # English, and each one's wire form (robot_summary's)
         self.guard = signing.ReplayGuard(10.0)
         self.token = self.session.liveliness().declare_token("rover_web/fleet/alpha/alive")
         self.queryable = self.session.declare_queryable("rover_web/fleet/alpha/stop", self._on_stop)
@@ -57,7 +59,8 @@ class LightRobot:
             seq += 1
             summary = {"title": "Alpha", "url": ALPHA_URL, "link": "ok",
                        "mode": "estop" if self.engaged else "idle", "estop": {"engaged": self.engaged},
-                       "battery": {"percent": 81.0, "voltage": None}, "position": self.position, "alerts": []}
+                       "battery": {"percent": 81.0, "voltage": None}, "position": self.position,
+                       "alerts": self.alerts[0], "alerts_i18n": self.alerts[1]}
             self.publisher.put(signing.signed_summary(KEY, "fleet", "alpha", seq, summary))
 
     def close(self) -> None:
@@ -118,9 +121,12 @@ def test_the_hub_page_shows_a_robot_heard_and_the_answers_of_stop_all(hub, stric
     assert page.evaluate("window.__csp") == []
 
 
-def test_the_hub_has_the_display_menu_its_theme_and_language_kept(hub, strict_page):
-    """The fleet's page is read in the sun too: the same Display menu as a robot's pages, kept the same way."""
-    url, _robot = hub
+def test_the_hub_has_the_display_menu_its_theme_and_language_kept(hub, strict_page, app_factory):
+    """The fleet's page is read in the sun too: the same Display menu as a robot's pages, kept the same way;
+    a robot's alerts in the page's language, drawn by the server and then by the page."""
+    url, robot = hub
+    line = breach_alerts(app_factory())  # a real robot's summary while outside its geofence
+    robot.alerts = (line["alerts"], line["alerts_i18n"])
     page = strict_page
     page.goto(url + "/robots")
     page.locator("#hub-table tr[data-robot='alpha']").wait_for(timeout=10000)
@@ -129,12 +135,19 @@ def test_the_hub_has_the_display_menu_its_theme_and_language_kept(hub, strict_pa
     assert page.evaluate("document.documentElement.dataset.theme") == "daylight"
     assert page.evaluate("getComputedStyle(document.body).backgroundColor") == "rgb(238, 241, 244)"
     page.locator("#display-language").select_option("es")
-    with page.expect_navigation():
+    with page.expect_navigation() as navigation:
         page.locator("#display-language").press("Enter")
     assert page.evaluate("[document.documentElement.lang, document.documentElement.dataset.theme]") == [
         "es", "daylight"]
     assert page.locator("#hub-stop-all").inner_text() == "Parar todo"
-    page.locator("#hub-table tr[data-robot='alpha']").wait_for(timeout=10000)
+    row = page.locator("#hub-table tr[data-robot='alpha']")
+    row.wait_for(timeout=10000)
+    assert "el robot salió de la geovalla" in navigation.value.text()  # the server's rendering
+    # The page's own drawing: its filter finds the robot by the translated alert's words.
+    page.fill("#hub-filter", "zona prohibida")
+    page.locator("#hub-table tr[data-robot='alpha']", has_text="zona prohibida 'dock'").wait_for(timeout=10000)
+    assert "left the geofence" not in row.inner_text()
+    page.fill("#hub-filter", "")
     # The audit every robot page passes (tests/browser/test_a11y_audit.py), in both themes and sizes.
     page.add_script_tag(url=url + AXE_URL)
     found = {}

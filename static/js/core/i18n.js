@@ -109,8 +109,11 @@ function isWire(value) {
 }
 export function said(source, key) {
   if (!source) return '';
-  const wire = source[`${key}_i18n`];
-  return isWire(wire) ? fromWire(wire) : (source[key] ?? '');
+  return saidWire(source[key] ?? '', source[`${key}_i18n`]);
+}
+// The same for a sentence and its wire form kept apart (a list of them: a robot's alerts on the hub).
+export function saidWire(english, wire) {
+  return isWire(wire) ? fromWire(wire) : english;
 }
 
 // gettext's plural forms from Intl's categories. Babel writes a language's forms in CLDR's order of

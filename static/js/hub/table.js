@@ -4,7 +4,7 @@
 // are the page's, kept across polls. Untrusted text goes through textContent only.
 import { ESTOP_WORDS, LINK_WORDS, MODE_WORDS, estopState } from '../fleet/map.js';
 import { EVENT_WORDS } from './history.js';
-import { _, ngettext, formatUnit } from '../core/i18n.js';
+import { _, ngettext, formatUnit, saidWire } from '../core/i18n.js';
 
 const ORDER = { live: 0, waiting: 1, lost: 2 };
 
@@ -18,6 +18,12 @@ function sortValue(r, key) {
     case 'title': return String(r.title || r.name).toLowerCase();
     default: return String(r[key] ?? '');
   }
+}
+
+// A robot's alerts in this page's language (the robot sends each one's id and values beside its English).
+function alertTexts(r) {
+  const wires = Array.isArray(r.alerts_i18n) ? r.alerts_i18n : [];
+  return (r.alerts || []).map((english, i) => saidWire(english, wires[i]));
 }
 
 function cell(text) {
@@ -59,7 +65,7 @@ function row(r) {
   history.append(open);
   tr.append(name, heard, cell(LINK_WORDS[r.link] || r.link), cell(r.mode ? MODE_WORDS[r.mode] || r.mode : '—'), cell(battery),
             cell(estop === 'unknown' ? '—' : ESTOP_WORDS[estop]),
-            cell(position), cell((r.alerts || []).join('; ')), history);
+            cell(position), cell(alertTexts(r).join('; ')), history);
   return tr;
 }
 
@@ -71,7 +77,7 @@ export function createTable(table, filterInput, counts) {
 
   function matches(r, needle) {
     if (!needle) return true;
-    return [r.name, r.title, r.heard, r.mode, r.link, ...(r.alerts || [])]
+    return [r.name, r.title, r.heard, r.mode, r.link, ...(r.alerts || []), ...alertTexts(r)]
       .some((v) => typeof v === 'string' && v.toLowerCase().includes(needle));
   }
 
