@@ -45,7 +45,7 @@ time.sleep(3600)
 """
 
 # A shared object's path fragment -> the library it stands for.
-LIBRARIES = {"shapely": "shapely", "PIL/_imaging": "Pillow", "_argon2_cffi_bindings": "argon2",
+LIBRARIES = {"shapely": "shapely", "PIL/_imaging": "Pillow", "lxml/": "lxml (URDF)", "_argon2_cffi_bindings": "argon2",
              "lz4/": "lz4 (mcap)", "zstandard": "zstandard (mcap)", "aiortc": "aiortc", "av/": "av",
              "jsonschema": "jsonschema", "_asyncio": "asyncio"}
 

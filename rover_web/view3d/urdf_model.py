@@ -11,8 +11,6 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from lxml import etree
-
 from rover_web.web.api_messages import as_text, said, with_wire
 
 MAX_URDF_BYTES = 8 * 1024 * 1024
@@ -42,6 +40,9 @@ class Model:
 
 
 def _tree(text: str):
+    # lxml (4 MB) only once a description comes: an idle robot, or one without a URDF, never loads it.
+    from lxml import etree
+
     try:
         # no entities, no network: a description is data, never a fetch
         parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=False)
@@ -52,6 +53,8 @@ def _tree(text: str):
 
 
 def _line_of(root, place: str) -> int | None:
+    from lxml import etree
+
     try:
         found = root.getroottree().xpath(place)
     except etree.XPathError:

@@ -8,7 +8,8 @@ import json
 import subprocess
 import sys
 
-DEFERRED = ("shapely", "PIL.Image", "lz4", "zstandard", "mcap.stream_reader", "rclpy.action", "nav2_msgs.action")
+DEFERRED = ("shapely", "PIL.Image", "lz4", "zstandard", "mcap.stream_reader", "rclpy.action", "nav2_msgs.action",
+            "lxml")
 
 SCRIPT = """
 import json, sys
@@ -26,6 +27,10 @@ try:
         out["fence"] = client.put("/api/geofence", json=fence).status_code
         out["outside"] = client.post("/api/waypoints", json={"lng": 5.0, "lat": 5.0}).status_code
         out["nodes"] = client.get("/api/nodes").status_code
+        from rover_web.view3d.service import View3dService  # a robot description comes: lxml parses it
+        view3d = rover.feature(View3dService)
+        view3d.on_description('<robot name="r"><link name="base_link"/></robot>', "test")
+        out["urdf"] = view3d.robot()["state"]
         if sys.argv[4]:  # a floorplan with a keep-out area: a goal inside it, and its thumbnail
             name = sys.argv[4]
             out["keep_out"] = client.post(f"/api/maps/{name}/goal", json={"x": 35.0, "y": 2.0, "yaw": 0.0}).status_code
@@ -52,8 +57,8 @@ def test_a_robot_with_no_floorplans_loads_none_of_them_until_used(tmp_path):
     out = run_app(tmp_path, use=True, ROVER_WEB_MAPS_FILE=None)
     assert out["at_start"] == []
     # Used, each works: the fence is stored and refuses a waypoint outside it, /ros lists the graph.
-    assert (out["fence"], out["outside"], out["nodes"]) == (200, 422, 200)
-    assert {"shapely", "rclpy.action"} <= set(out["after_use"])
+    assert (out["fence"], out["outside"], out["nodes"], out["urdf"]) == (200, 422, 200, "ok")
+    assert {"shapely", "rclpy.action", "lxml"} <= set(out["after_use"])
 
 
 def test_the_bundled_floorplans_are_checked_at_start_by_a_child_and_loaded_when_used(tmp_path):
