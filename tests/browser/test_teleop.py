@@ -140,11 +140,15 @@ def test_joystick_drives_release_hide_blur_and_leaving_stop(rig, page, sim_proce
     page.evaluate("addEventListener('pagehide', () => sessionStorage.setItem('hid_at', String(Date.now())))")
     page.goto(server.url + "/api/status")
     hid_at = float(page.evaluate("sessionStorage.getItem('hid_at')")) / 1000
-    zero = peer.wait_for("/cmd_vel", lambda m: is_zero(m), timeout=2.0)
-    # After the pagehide, never before it (both the machine's wall clock; Date.now() is whole ms).
-    assert -0.002 < zero["sent"] - hid_at < 1.0, f"pagehide: zero {zero['sent'] - hid_at:.3f} s after it"
-    time.sleep(0.4)
-    assert all(lin == 0.0 and ang == 0.0 for _, lin, ang in twists(peer) if _ >= zero["t"]), "pagehide"
+    # Left stopped, within a second of the pagehide (both the machine's wall clock, each twist by its
+    # source timestamp). The zero that ended the motion is the close's, or, on a loaded machine, the
+    # deadman's between two of the page's last frames (then nothing held is left to stop on close).
+    time.sleep(1.4)
+    sent = [(e["sent"], is_zero(e["msg"])) for e in peer.received("/cmd_vel")]
+    assert sent and sent[-1][1], "pagehide: the robot was left moving"
+    last_moving = max((t for t, zero in sent if not zero), default=None)
+    stop = next(t for t, zero in sent if zero and (last_moving is None or t > last_moving))
+    assert stop - hid_at < 1.0, f"pagehide: zero {stop - hid_at:.3f} s after it"
     assert page.watch.offhost == []
     assert page.watch.console_errors == []
 
