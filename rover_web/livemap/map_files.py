@@ -20,7 +20,6 @@ lead elsewhere are refused, so no request can ever reach a file outside it.
 
 from __future__ import annotations
 
-import io
 import json
 import math
 import re
@@ -39,11 +38,9 @@ from rover_web.config import ROOT, ConfigError
 
 from .geometry import MapGeometry, wrap_angle
 from .keep_out import KeepOutArea, parse_keep_out
+from .map_images import MAP_IMAGE_FORMATS, MAX_IMAGE_SIDE_PX, display_png, make_thumbnail
 
 IMAGE_SUFFIXES = (".png", ".pgm")
-MAP_IMAGE_FORMATS = ("PNG", "PPM")  # Pillow reads PGM as its PPM format; nothing else is opened
-MAX_IMAGE_SIDE_PX = 8192
-THUMBNAIL_SIDE_PX = 320
 MAX_NAME_CHARS = 80
 _BAD_NAME = re.compile(r"[/\\\x00-\x1f\x7f]")
 MAP_SERVER_DEFAULTS = {"negate": 0, "occupied_thresh": 0.65, "free_thresh": 0.25, "mode": "trinary"}
@@ -93,7 +90,7 @@ class MapDefinition:
         """The floorplan as PNG bytes (PGM converted, negate applied), made once."""
         with self._lock:
             if self._png is None:
-                self._png = self.renderer() if self.renderer else _display_png(self.image_path, self.yaml)
+                self._png = self.renderer() if self.renderer else display_png(self.image_path, self.yaml)
             return self._png
 
     def thumbnail(self) -> bytes:
@@ -105,38 +102,6 @@ class MapDefinition:
 
     def waypoint(self, name: str) -> Waypoint | None:
         return next((w for w in self.waypoints if w.name == name), None)
-
-
-def make_thumbnail(png: bytes, side_px: int = THUMBNAIL_SIDE_PX) -> bytes:
-    from PIL import Image  # here and below: a robot with no floorplans never loads Pillow (issue 32)
-
-    with Image.open(io.BytesIO(png), formats=("PNG",)) as image:
-        image = image.convert("RGBA" if "A" in image.getbands() else "RGB")
-        image.thumbnail((side_px, side_px), Image.Resampling.BOX)  # BOX keeps thin walls visible as grey
-        out = io.BytesIO()
-        image.save(out, "PNG", optimize=True)
-        return out.getvalue()
-
-
-def _display_png(path: Path, params: dict) -> bytes:
-    """Browsers cannot show PGM, and a negated map would show free space dark: fix both for display."""
-    negate = bool(params.get("negate", 0))
-    if path.suffix.lower() == ".png" and not negate:
-        return path.read_bytes()
-    from PIL import Image, ImageOps
-
-    with Image.open(path, formats=MAP_IMAGE_FORMATS) as image:
-        image.load()
-        if negate:
-            if image.mode in ("LA", "RGBA"):
-                *colour, alpha = image.split()
-                colour = [ImageOps.invert(band) for band in colour]
-                image = Image.merge(image.mode, (*colour, alpha))
-            else:
-                image = ImageOps.invert(image.convert("RGB" if image.mode not in ("L", "RGB") else image.mode))
-        out = io.BytesIO()
-        image.save(out, "PNG")
-        return out.getvalue()
 
 
 # --- loading ---

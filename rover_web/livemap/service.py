@@ -23,7 +23,8 @@ from rover_web.web.api_messages import explain
 from . import msgs
 from .geometry import MapGeometry, wrap_angle
 from .keep_out import check_goal
-from .map_files import MAX_IMAGE_SIDE_PX, MapDefinition, load_catalog_checked_apart, maps_file_path
+from .map_files import MapDefinition, load_catalog_checked_apart, maps_file_path
+from .map_images import MAX_IMAGE_SIDE_PX
 from .occupancy import grid_to_image, image_to_png
 from .state import LiveMap, Pose2D, RobotTrack, UnknownMap, goal_payload, plan_payload, pose_payload
 

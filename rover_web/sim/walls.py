@@ -15,7 +15,8 @@ import numpy as np
 from PIL import Image
 
 from rover_web.livemap.geometry import MapGeometry
-from rover_web.livemap.map_files import MAP_IMAGE_FORMATS, MapDefinition
+from rover_web.livemap.map_files import MapDefinition
+from rover_web.livemap.map_images import MAP_IMAGE_FORMATS
 
 ROBOT_RADIUS_M = 0.2  # LiveMap's default robot is 35.4 cm across
 STALL_AFTER_S = 5.0   # pushing this long with less than STALL_MOVE_M of progress: the way is blocked
