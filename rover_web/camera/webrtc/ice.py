@@ -8,6 +8,8 @@ function reads: asyncio tasks inherit context variables, so a peer connection wh
 description is set inside `with only_host_addresses(...)` gathers (and binds UDP sockets) on those
 addresses alone, while other code in the same process (another app, a test client) keeps its own.
 `filter_candidates` then drops any other candidate from the answer, as a second guard.
+`host_addresses(config)` is which addresses those are (the setting's, or 127.0.0.1 for a server that
+listens on loopback only), and `without_mdns` drops an offer's `.local` candidates.
 Pure Python apart from the aioice import.
 """
 
@@ -18,6 +20,10 @@ import contextvars
 import ipaddress
 import re
 from collections.abc import Iterable, Iterator
+
+from rover_web import process
+from rover_web.auth.policy import is_loopback
+from rover_web.config import ConfigError
 
 _HOST_ADDRESSES: contextvars.ContextVar[tuple[str, ...] | None] = contextvars.ContextVar(
     "rover_web_webrtc_host_addresses", default=None)
@@ -143,3 +149,28 @@ def parse_ice_server(text: str) -> dict:
     elif match.group(1).startswith("turn"):
         raise ValueError(f"{text[:80]!r}: a TURN server needs credentials (turn:user:secret@host:port)")
     return server
+
+
+def host_addresses(config) -> tuple[str, ...]:
+    """The setting's addresses; when it is empty and the server listens on loopback only, 127.0.0.1
+    (nobody elsewhere can reach the page, so no other address is worth offering: the tests rely on
+    this); else () for every interface's."""
+    try:
+        chosen = check_addresses(config["ROVER_WEB_WEBRTC_HOST_ADDRESSES"])
+    except ValueError as exc:
+        raise ConfigError(f"ROVER_WEB_WEBRTC_HOST_ADDRESSES: {exc}") from None
+    if chosen:
+        return chosen
+    listening = process.listen_hosts(config)
+    if listening and all(is_loopback(h) for h in listening):
+        return ("127.0.0.1",)
+    return ()
+
+
+def without_mdns(offer: str) -> str:
+    """Drop the offer's mDNS (`.local`) candidates: resolving them would send multicast queries on
+    every interface. A browser behind one is found anyway, from its connectivity checks (a
+    peer-reflexive candidate)."""
+    lines = offer.split("\n")
+    kept = [line for line in lines if not ((found := candidate_address(line)) and found[0].endswith(".local"))]
+    return "\n".join(kept)

@@ -30,8 +30,6 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from rover_web import process
-from rover_web.auth.policy import is_loopback
 from rover_web.camera import msgs as camera_msgs
 from rover_web.camera.service import CameraStreams, CannotSubscribe, Unavailable
 from rover_web.camera.stream import FrameProducer, StreamKey
@@ -46,12 +44,12 @@ from . import frames
 from .adapt import AdaptPolicy
 from .feedback import tap_rtcp
 from .ice import (
-    candidate_address,
-    check_addresses,
     filter_candidates,
+    host_addresses,
     only_host_addresses,
     parse_ice_server,
     screen_remote_candidates,
+    without_mdns,
 )
 from .loop import LoopStopped, LoopThread
 
@@ -130,31 +128,6 @@ class WhepSession:
                 "teleop": self.teleop is not None and not self.teleop.closed,
                 "source_hz": self.producer.arrivals.snapshot(stale_after_s=2.0)["rate_hz"] if self.producer else None,
                 "age_s": round(time.monotonic() - self.created, 1)}
-
-
-def host_addresses(config) -> tuple[str, ...]:
-    """The setting's addresses; when it is empty and the server listens on loopback only, 127.0.0.1
-    (nobody elsewhere can reach the page, so no other address is worth offering: the tests rely on
-    this); else () for every interface's."""
-    try:
-        chosen = check_addresses(config["ROVER_WEB_WEBRTC_HOST_ADDRESSES"])
-    except ValueError as exc:
-        raise ConfigError(f"ROVER_WEB_WEBRTC_HOST_ADDRESSES: {exc}") from None
-    if chosen:
-        return chosen
-    listening = process.listen_hosts(config)
-    if listening and all(is_loopback(h) for h in listening):
-        return ("127.0.0.1",)
-    return ()
-
-
-def _without_mdns(offer: str) -> str:
-    """Drop the offer's mDNS (`.local`) candidates: resolving them would send multicast queries on
-    every interface. A browser behind one is found anyway, from its connectivity checks (a
-    peer-reflexive candidate)."""
-    lines = offer.split("\n")
-    kept = [line for line in lines if not ((found := candidate_address(line)) and found[0].endswith(".local"))]
-    return "\n".join(kept)
 
 
 def _check_fingerprints(offer: str) -> None:
@@ -383,7 +356,7 @@ class WebRtcService:
                 self._on_datachannel(session, channel)
 
             try:
-                await pc.setRemoteDescription(RTCSessionDescription(sdp=_without_mdns(offer), type="offer"))
+                await pc.setRemoteDescription(RTCSessionDescription(sdp=without_mdns(offer), type="offer"))
             except Exception as exc:  # aiortc raises ValueError, KeyError, IndexError... for bad SDP
                 raise InvalidInput("the SDP offer could not be used: %(value)s",
                                    "bad_sdp", value=str(exc)[:200] or type(exc).__name__) from None
