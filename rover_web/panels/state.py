@@ -31,6 +31,14 @@ class Refusal:
         return self.reason
 
 
+def _either(values) -> Text | str:
+    """"Standby or Hovering", in each viewer's language (a said sentence nests: "A or B or C")."""
+    text: Text | str = str(values[0])
+    for value in values[1:]:
+        text = said("%(some)s or %(other)s", some=text, other=str(value))
+    return text
+
+
 def format_value(display: DisplaySpec, value: Any) -> str:
     """The text an operator reads: floats to the display's digits, messages as `k v · k v`."""
     if value is None:
@@ -133,7 +141,7 @@ class PanelState:
             for display_id, allowed in control.enabled_when:
                 display = self.spec.display(display_id)
                 value, age, fresh = self.reading(display_id, now)
-                wanted = " or ".join(str(v) for v in allowed)
+                wanted = _either(allowed)
                 if age is None:
                     return Refusal("not_allowed", said("%(label)s needs %(display)s to be %(wanted)s; no "
                                                        "%(display)s has been received yet",

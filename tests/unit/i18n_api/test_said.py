@@ -12,6 +12,9 @@ from rover_web.config import ROOT
 from rover_web.geofence.rules import parse_fence
 from rover_web.geofence.service import breach_message
 from rover_web.i18n.catalogues import compile_language
+from rover_web.panels import spec
+from rover_web.panels.msgs import field_kind
+from rover_web.panels.state import PanelState
 from rover_web.teleop.link import verdict
 from rover_web.tf.buffer import TfBuffer
 from rover_web.web.api_messages import Text, explain, said, with_wire
@@ -61,6 +64,14 @@ def said_by_the_server() -> list[Text]:
     buffer.set_transform("c", "d", (0, 0, 0), (0, 0, 0, 1), 1, static=True)
     tree = buffer.frames(10**9)
     found += [w["message"] for w in tree["warnings"]] + [r["message"] for r in tree["rejected"]]
+    (panel,) = spec.load(None, 2.0, field_kind)  # the drone's: a control allowed in either of two states
+    state = PanelState(panel, lambda: 1000.0)
+    refused = [c["reason"] for c in state.view()["controls"].values() if c["reason"]]  # locked
+    state.unlock()
+    state.update("status", "Flying")
+    refused += [c["reason"] for c in state.view()["controls"].values() if c["reason"]]
+    assert any(" or " in r for r in refused)
+    found += refused
     assert all(isinstance(t, Text) for t in found) and len(found) >= 10
     return found
 
