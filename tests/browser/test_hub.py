@@ -13,6 +13,7 @@ from werkzeug.serving import make_server
 
 from rover_web.zenoh_link import signing
 from tests.browser.test_a11y_audit import AXE_URL, SIZES, THEMES, audit
+from tests.browser.test_languages import NOT_INTERFACE, READ_TEXT, english_patterns, leftovers
 from tests.conftest import free_port
 from tests.unit.zenoh_link.test_alerts import breach_alerts
 
@@ -143,6 +144,9 @@ def test_the_hub_has_the_display_menu_its_theme_and_language_kept(hub, strict_pa
     row = page.locator("#hub-table tr[data-robot='alpha']")
     row.wait_for(timeout=10000)
     assert "el robot salió de la geovalla" in navigation.value.text()  # the server's rendering
+    # No English left on the page as its scripts drew it (the robot pages' check, tests/browser/test_languages.py).
+    page.wait_for_timeout(500)
+    assert leftovers(page.evaluate(READ_TEXT, NOT_INTERFACE), english_patterns("es")) == []
     # The page's own drawing: its filter finds the robot by the translated alert's words.
     page.fill("#hub-filter", "zona prohibida")
     page.locator("#hub-table tr[data-robot='alpha']", has_text="zona prohibida 'dock'").wait_for(timeout=10000)

@@ -3,6 +3,7 @@
 // (rover_web/basemap), a graticule to read positions by, and the same controls everywhere.
 // maplibregl is the vendored global (static/vendor/maplibre-gl-*), loaded with `defer`.
 import { effectiveTheme, onThemeChange, themeColour } from '../core/theme.js';
+import { _ } from '../core/i18n.js';
 
 // Coordinates keep the decimal point and N/S/E/W whatever the page's language (ISO 6709's letters):
 // operators read them into other tools as they are.
@@ -95,13 +96,28 @@ function graticule(bounds) {
   return { type: 'FeatureCollection', features };
 }
 
+// MapLibre's own words (its canvas's label, its buttons' titles) in the page's language; its unit
+// symbols stay as they are.
+function mapLocale() {
+  return {
+    'Map.Title': _('Map'),
+    'Marker.Title': _('Map marker'),
+    'Popup.Close': _('Close popup'),
+    'NavigationControl.ZoomIn': _('Zoom in'),
+    'NavigationControl.ZoomOut': _('Zoom out'),
+    'NavigationControl.ResetBearing': _('Drag to rotate map, click to reset north'),
+    'AttributionControl.ToggleAttribution': _('Toggle attribution'),
+    'AttributionControl.MapFeedback': _('Map feedback'),
+  };
+}
+
 // The map in `container`, or throws when this browser cannot show one (no WebGL): callers keep
 // their lists working without it. onLoad runs once the style is in (sources can be set), before
 // container.dataset.ready becomes 'yes'.
 export function createGpsMap(container, cfg, { sources = {}, layers = [], onLoad = () => {} } = {}) {
   const map = new maplibregl.Map({
     container, style: buildStyle(cfg, sources, layers), center: cfg.center, zoom: cfg.zoom,
-    attributionControl: { compact: true }, dragRotate: false, pitchWithRotate: false,
+    attributionControl: { compact: true }, dragRotate: false, pitchWithRotate: false, locale: mapLocale(),
   });
   map.touchZoomRotate.disableRotation();
   map.addControl(new maplibregl.NavigationControl({ showCompass: false }));
