@@ -77,7 +77,7 @@ def init_app(app: Flask) -> None:
     # A sentence the server made (api_messages.said or explain) in the page's language: `{{ x|translated }}`.
     app.jinja_env.filters["translated"] = lambda value: value.translated() if isinstance(value, Text) else value
     # One received from elsewhere in its wire form (a robot's alerts on the hub): `{{ english|from_wire(wire) }}`.
-    app.jinja_env.filters["from_wire"] = lambda english, wire: from_wire(wire, english) if wire else english
+    app.jinja_env.filters["from_wire"] = lambda english, wire: from_wire(wire, english)
 
     @app.context_processor
     def _page_language():

@@ -21,11 +21,10 @@ from pathlib import Path
 import pytest
 
 from rover_web.config import ROOT
-from rover_web.geofence.rules import parse_fence
-from rover_web.geofence.service import breach_message
 from rover_web.i18n.catalogues import compile_language
 from rover_web.teleop.link import verdict
 from rover_web.web.api_messages import Text, with_wire
+from tests.support.geofence_helpers import DOCK, breach_at
 
 pytestmark = pytest.mark.browser
 
@@ -179,10 +178,7 @@ def test_a_japanese_page_has_one_plural_form(page, server):
 
 def said_payloads() -> dict:
     """Sentences as the server pushes them to every viewer, made by the real code and sent as JSON."""
-    fence = parse_fence({"type": "FeatureCollection", "features": [{
-        "type": "Feature", "properties": {"kind": "keep_out", "name": "dock"},
-        "geometry": {"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]]}}]}, 1000)
-    breach = with_wire({"state": "outside", "message": breach_message(fence.refusal(0.5, 0.5))})
+    breach = with_wire({"state": "outside", "message": breach_at(DOCK, 0.5, 0.5)})
     quality, why = verdict(12345.0, None, 0.0, 0.0)
     link = with_wire({"quality": quality, "why": why})
     return json.loads(json.dumps({"breach": breach, "link": link, "plain": {"message": "a robot's own words"},

@@ -18,6 +18,7 @@ from rover_web.panels.state import PanelState
 from rover_web.teleop.link import verdict
 from rover_web.tf.buffer import TfBuffer
 from rover_web.web.api_messages import Text, explain, said, with_wire
+from tests.support.geofence_helpers import DOCK, area, collection, square
 
 
 def ids(wire: dict) -> set[str]:
@@ -42,14 +43,8 @@ def test_the_wire_form_is_the_msgid_and_values_beside_the_english():
 
 
 def fence():
-    return parse_fence({"type": "FeatureCollection", "features": [
-        {"type": "Feature", "properties": {"kind": "keep_in"},
-         "geometry": {"type": "Polygon", "coordinates": [[[0, 0], [2, 0], [2, 2], [0, 2], [0, 0]]]}},
-        {"type": "Feature", "properties": {"kind": "keep_out", "name": "dock"},
-         "geometry": {"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]]}},
-        {"type": "Feature", "properties": {"kind": "keep_out"},
-         "geometry": {"type": "Polygon", "coordinates": [[[1.5, 1.5], [1.9, 1.5], [1.9, 1.9], [1.5, 1.5]]]}},
-    ]}, 1000)
+    return parse_fence(collection(area("keep_in", square(0, 0, 2, 2)), *DOCK["features"],
+                                  area("keep_out", [[1.5, 1.5], [1.9, 1.5], [1.9, 1.9], [1.5, 1.5]])), 1000)
 
 
 def said_by_the_server() -> list[Text]:

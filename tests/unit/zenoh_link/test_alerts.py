@@ -7,19 +7,14 @@ import json
 
 import pytest
 
-from rover_web.geofence.rules import parse_fence
-from rover_web.geofence.service import breach_message
 from rover_web.web.api_messages import from_wire, with_wire
 from rover_web.zenoh_link.robot import robot_summary
-
-DOCK = {"type": "FeatureCollection", "features": [{
-    "type": "Feature", "properties": {"kind": "keep_out", "name": "dock"},
-    "geometry": {"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]]}}]}
+from tests.support.geofence_helpers import DOCK, breach_at
 
 
 def breach_alerts(app) -> dict:
     rover = app.extensions["rover_web"]
-    message = breach_message(parse_fence(DOCK, 1000).refusal(0.5, 0.5))
+    message = breach_at(DOCK, 0.5, 0.5)
     rover.hub.publish("geofence", with_wire({"state": "outside", "message": message}))
     # As it crosses Zenoh: JSON, signed, opened on the hub.
     return json.loads(json.dumps(robot_summary(rover, None)))
