@@ -195,8 +195,7 @@ class TfBuffer:
             stamps = frame.stamps
             if stamps and stamp_ns >= stamps[-1]:
                 if stamp_ns == stamps[-1]:
-                    return self._reject("repeated", said("repeated stamp %(stamp)s for [%(child)s]",
-                                                     stamp=format(stamp_ns / 1e9, ".6f"), child=child))
+                    return self._reject("repeated", _repeated(stamp_ns, child))
                 stamps.append(stamp_ns)
                 frame.values.append(value)
             else:
@@ -207,8 +206,7 @@ class TfBuffer:
                                                      cache=format(self.cache_s, "g")))
                 i = bisect_left(stamps, stamp_ns)
                 if i < len(stamps) and stamps[i] == stamp_ns:
-                    return self._reject("repeated", said("repeated stamp %(stamp)s for [%(child)s]",
-                                                     stamp=format(stamp_ns / 1e9, ".6f"), child=child))
+                    return self._reject("repeated", _repeated(stamp_ns, child))
                 stamps.insert(i, stamp_ns)
                 frame.values.insert(i, value)
             cut = stamps[-1] - self._cache_ns
@@ -432,6 +430,10 @@ class TfBuffer:
             warnings = [with_wire(w) for w in warnings]
         return {"frames": rows, "roots": roots, "warnings": warnings, "rejected": rejected,
                 "now": now / 1e9, "cache_s": self.cache_s}
+
+
+def _repeated(stamp_ns: int, child: str) -> Text:
+    return said("repeated stamp %(stamp)s for [%(child)s]", stamp=format(stamp_ns / 1e9, ".6f"), child=child)
 
 
 def _by(parent: str, authority: str) -> str:
