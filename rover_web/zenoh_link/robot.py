@@ -38,19 +38,17 @@ RETRY_S = 2.0  # between attempts to open the session
 CHANGE_FIELDS = ("link", "mode", "operator", "estop", "alerts")  # sent at once when they change
 
 
+LINK_ALERTS = {"stale": said("link stale"), "degraded": said("link degraded")}
+
+
 def robot_summary(rover: Rover, public_url: str | None) -> dict:
     """The robot's line of GET /api/robots, its URL made absolute for the hub, and its alerts."""
     line = fleet_summary(rover, "")
     line["url"] = f"{public_url.rstrip('/')}{line['url']}" if public_url else None
-    alerts: list[Text] = []
-    if line["link"] == "stale":
-        alerts.append(said("link stale"))
-    elif line["link"] == "degraded":
-        alerts.append(said("link degraded"))
+    alerts: list[Text] = [LINK_ALERTS[line["link"]]] if line["link"] in LINK_ALERTS else []
     geofence = rover.hub.latest("geofence") or {}
-    if geofence.get("state") == "outside":
-        message = geofence.get("message")
-        alerts.append(message if isinstance(message, Text) else said("outside the geofence"))
+    if geofence.get("state") == "outside":  # its message: the breach banner's sentence (geofence/service.py)
+        alerts.append(geofence.get("message") or said("outside the geofence"))
     # The English for any reader, and each one's id and values for the hub's page in its language.
     line["alerts"] = [a.english() for a in alerts]
     line["alerts_i18n"] = [a.wire() for a in alerts]
