@@ -108,15 +108,16 @@ def toggle(page, layer, on):
 def test_every_overlay_is_drawn_where_its_coordinates_say_and_each_toggles(live_server, page, sensing):
     # A path for the pose history first: the robot drove north along x = 20, then to its spot.
     sensing.wait_match("/amcl_pose")
-    for y in (2.0, 2.5, 3.0, 3.5, 4.0, 4.5, 5.0, 5.5, 6.0):
-        sensing.publish("/amcl_pose", amcl(20.0, y))
-        time.sleep(0.05)
-    # The page reads the history once, then adds live poses, which a loaded machine may coalesce:
-    # open it when the server holds the whole drive.
+    # Each pose until the server holds it: the subscription keeps the last one (AMCL's own depth), so a
+    # loaded executor may take only the newest of two; the same pose again adds nothing to the trail.
+    # The page reads the history once, then adds live poses: it is opened when the whole drive is held.
     deadline = time.monotonic() + 15
-    while len(requests.get(f"{live_server.url}/api/overlays", timeout=5).json()["trail"]) < 9:
-        assert time.monotonic() < deadline, "the server never held the nine poses published"
-        time.sleep(0.1)
+    for i, y in enumerate((2.0, 2.5, 3.0, 3.5, 4.0, 4.5, 5.0, 5.5, 6.0)):
+        sensing.publish("/amcl_pose", amcl(20.0, y))
+        while len(requests.get(f"{live_server.url}/api/overlays", timeout=5).json()["trail"]) < i + 1:
+            assert time.monotonic() < deadline, "the server never held the nine poses published"
+            time.sleep(0.1)
+            sensing.publish("/amcl_pose", amcl(20.0, y))
     open_map(page, live_server.url)
     s = feed_until_drawn(page, sensing)
     layers = s["layers"]
