@@ -238,6 +238,9 @@ export function attachGeofence(map) {
     if (state.revision === fence.revision) return;
     let latest;
     try { latest = await api('GET', '/api/geofence'); } catch { return; /* the next event retries */ }
+    // This page's own save may have answered while the GET was out: then it shows that fence already,
+    // and showing it again would drop what the operator selected since.
+    if (latest.revision === fence.revision) return;
     if (!dirty) { show(latest); return; }
     fence = latest;  // keep the draft; "Revert" shows theirs
     say(_('The fence was changed elsewhere; "Revert" shows the new one'), 'error');
